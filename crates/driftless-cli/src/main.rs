@@ -1,0 +1,2 @@
+//! `driftless` command-line tool.
+fn main() {}

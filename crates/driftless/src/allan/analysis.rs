@@ -1,0 +1,1 @@
+//! Per-channel analysis: estimator + tau grid + confidence intervals. (OWNER: lead)

@@ -1,0 +1,1 @@
+//! Stability estimators on phase data. (OWNER: lead)

@@ -1,0 +1,3 @@
+//! Noise-model file (TOML) written by `driftless allan` and read by the filter and simulator.
+//!
+//! OWNER: helper "fit".

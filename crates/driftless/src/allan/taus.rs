@@ -1,0 +1,1 @@
+//! Tau grids. (OWNER: lead)

@@ -1,0 +1,3 @@
+//! Reports and plots.
+//!
+//! OWNER: helper "plot".

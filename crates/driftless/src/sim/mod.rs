@@ -1,0 +1,3 @@
+//! Simulation with known truth.
+//!
+//! OWNER: helper "fit" (rng + static noise generator for issue 2).
