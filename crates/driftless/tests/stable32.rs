@@ -117,17 +117,32 @@ fn check_file(case: &Case, result_file: &str, tau0: f64) -> (usize, f64, f64) {
             );
         }
         if case.check_ci && r.lo > 0.0 && !exempt_ci {
-            let rl = (res.dev_lo[0] - r.lo).abs() / r.lo;
-            let rh = (res.dev_hi[0] - r.hi).abs() / r.hi;
+            // Interval shape: lo/σ and hi/σ against Stable32's, for every file. Where our σ
+            // itself matches Stable32 to 1e-4 (phasedat, pink) the absolute bounds must
+            // match too; for ocxo Stable32 ran on a differently rounded copy of the data, so
+            // its σ differs from ours by up to 2e-3 and that difference carries into the
+            // absolute bounds — the shape is what the confidence interval code determines.
+            let rl = (res.dev_lo[0] / p.dev - r.lo / r.dev).abs() / (r.lo / r.dev);
+            let rh = (res.dev_hi[0] / p.dev - r.hi / r.dev).abs() / (r.hi / r.dev);
+            let (al, ah) = (
+                (res.dev_lo[0] - r.lo).abs() / r.lo,
+                (res.dev_hi[0] - r.hi).abs() / r.hi,
+            );
+            let absolute = case.dev_tol <= 1e-4;
             worst_ci = worst_ci.max(rl).max(rh);
+            if absolute {
+                worst_ci = worst_ci.max(al).max(ah);
+            }
             assert!(
-                rl < 2e-3 && rh < 2e-3,
-                "{result_file} m={}: bounds ({}, {}) vs Stable32 ({}, {})",
+                rl < 2e-3 && rh < 2e-3 && (!absolute || (al < 2e-3 && ah < 2e-3)),
+                "{result_file} m={}: bounds ({}, {}) on σ {} vs Stable32 ({}, {}) on σ {}",
                 r.m,
                 res.dev_lo[0],
                 res.dev_hi[0],
+                p.dev,
                 r.lo,
-                r.hi
+                r.hi,
+                r.dev
             );
         }
     }

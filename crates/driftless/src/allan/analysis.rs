@@ -65,6 +65,32 @@ pub struct ChannelResult {
     pub edf: Vec<f64>,
     /// Confidence level of the bounds.
     pub confidence: f64,
+    /// Phase points of each gap-free segment the curve was computed from (one entry
+    /// for a contiguous log); lets callers recompute EDFs for another noise type.
+    pub segment_phase_points: Vec<usize>,
+    /// Whether the reduced-overlap fast estimator produced the curve.
+    pub fast: bool,
+}
+
+impl ChannelResult {
+    /// EDF of point `i` had the noise exponent been `alpha` (segments' EDFs add).
+    pub fn edf_for_alpha(&self, i: usize, alpha: i32) -> f64 {
+        let Some(p) = self.points.get(i) else {
+            return 0.0;
+        };
+        self.segment_phase_points
+            .iter()
+            .filter(|&&n| n > p.m)
+            .map(|&n| {
+                if self.fast {
+                    ci::edf_strided(alpha, p.m, (p.m / FAST_OVERLAP).max(1), n)
+                } else {
+                    ci::edf(self.estimator, alpha, p.m, n)
+                }
+            })
+            .filter(|e| e.is_finite() && *e > 0.0)
+            .sum()
+    }
 }
 
 /// Analyse one channel given as one or more contiguous segments (segments come from
@@ -196,6 +222,8 @@ pub fn analyse_segments(
         alpha: alphas,
         edf: edfs,
         confidence: cfg.confidence,
+        segment_phase_points: phases.iter().map(Vec::len).collect(),
+        fast: cfg.fast,
     })
 }
 
@@ -207,4 +235,17 @@ pub fn analyse(
     cfg: &AnalysisConfig,
 ) -> Result<ChannelResult, AllanError> {
     analyse_segments(name, &[values], tau0_s, cfg)
+}
+
+/// Analyse several channels (each given as its gap-free segments) in parallel.
+/// Results come back in input order; the first error wins.
+pub fn analyse_channels(
+    channels: &[(&str, Vec<&[f64]>)],
+    tau0_s: f64,
+    cfg: &AnalysisConfig,
+) -> Result<Vec<ChannelResult>, AllanError> {
+    channels
+        .par_iter()
+        .map(|(name, segs)| analyse_segments(name, segs, tau0_s, cfg))
+        .collect()
 }

@@ -77,8 +77,24 @@ pub fn sums(estimator: Estimator, x: &[f64], ms: &[usize]) -> Vec<Sums> {
 /// S = m / stride) in exchange for touching ~overlap·N/m terms per tau.
 pub fn oadev_strided_sums(x: &[f64], ms: &[usize], overlap: usize) -> Vec<Sums> {
     let overlap = overlap.max(1);
-    ms.par_iter()
-        .map(|&m| strided::<2>(x, m, (m / overlap).max(1)))
+    // Factors whose stride is 1 are the fully overlapping estimator: use the blocked,
+    // vectorised path for them.
+    let dense: Vec<usize> = ms.iter().copied().filter(|&m| m / overlap <= 1).collect();
+    let mut dense_sums = overlapping::<2>(x, &dense).into_iter();
+    let sparse: Vec<Sums> = ms
+        .par_iter()
+        .filter(|&&m| m / overlap > 1)
+        .map(|&m| strided::<2>(x, m, m / overlap))
+        .collect();
+    let mut sparse = sparse.into_iter();
+    ms.iter()
+        .filter_map(|&m| {
+            if m / overlap <= 1 {
+                dense_sums.next()
+            } else {
+                sparse.next()
+            }
+        })
         .collect()
 }
 
