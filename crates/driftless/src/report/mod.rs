@@ -1,3 +1,9 @@
 //! Reports and plots.
 //!
-//! OWNER: helper "plot".
+//! [`plot`]: generic log-log figures (SVG, PNG with the `png` feature);
+//! [`allan_plot`]: the Allan-deviation figure built from analysis results.
+
+pub mod plot;
+
+pub use plot::{Figure, PlotError, render_png, render_png_bytes, render_svg};
+pub mod allan_plot;

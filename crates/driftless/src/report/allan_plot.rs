@@ -1,0 +1,182 @@
+//! The Allan-deviation figure: one log-log panel per channel with the deviation and its
+//! confidence bars, the fitted noise model, and each fitted term's asymptote labelled
+//! with its value (IEEE Std 952-1997 Annex C slopes: Q −1, N −½, B 0, K +½, R +1).
+
+use super::plot::{
+    Annotation, Color, Figure, Line, LogLogPlot, PALETTE, PlotError, Series, render_png,
+    write_svg,
+};
+use crate::allan::analysis::ChannelResult;
+use crate::allan::fit::{NoiseFit, gauss_markov_avar};
+use crate::io::log::Quantity;
+use driftless_model::units::{DEG, DEG_PER_H, MILLI_G};
+use std::path::Path;
+
+/// Display unit of a deviation axis: (factor SI→display, label).
+fn axis_unit(q: Quantity, fallback: &str) -> (f64, String) {
+    match q {
+        Quantity::AngularRate => (1.0 / DEG_PER_H, "deg/h".into()),
+        Quantity::SpecificForce => (1.0 / MILLI_G, "mg".into()),
+        _ => (
+            1.0,
+            if fallback.is_empty() {
+                "data units".into()
+            } else {
+                fallback.into()
+            },
+        ),
+    }
+}
+
+/// Term labels in the units engineers quote (continuous-time densities).
+fn term_label(term: char, q: Quantity, v: f64) -> String {
+    let s = |x: f64| format_sig(x);
+    match (q, term) {
+        (Quantity::AngularRate, 'Q') => format!("Q = {} µrad", s(v * 1e6)),
+        (Quantity::AngularRate, 'N') => format!("N = {} deg/√h", s(v / DEG * 60.0)),
+        (Quantity::AngularRate, 'B') => format!("B = {} deg/h", s(v / DEG_PER_H)),
+        (Quantity::AngularRate, 'K') => format!("K = {} deg/h/√h", s(v / DEG * 3600.0 * 60.0)),
+        (Quantity::AngularRate, 'R') => format!("R = {} deg/h²", s(v / DEG * 3600.0 * 3600.0)),
+        (Quantity::SpecificForce, 'Q') => format!("Q = {} mm/s", s(v * 1e3)),
+        (Quantity::SpecificForce, 'N') => format!("N = {} m/s/√h", s(v * 60.0)),
+        (Quantity::SpecificForce, 'B') => format!("B = {} µg", s(v / MILLI_G * 1e3)),
+        (Quantity::SpecificForce, 'K') => format!("K = {} m/s²/√s", s(v)),
+        (Quantity::SpecificForce, 'R') => format!("R = {} m/s³", s(v)),
+        (_, t) => format!("{t} = {}", s(v)),
+    }
+}
+
+fn format_sig(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || !a.is_finite() {
+        format!("{x}")
+    } else if !(1e-3..1e4).contains(&a) {
+        format!("{x:.2e}")
+    } else {
+        let d = (2 - a.log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{x:.d$}")
+    }
+}
+
+/// Build the figure. `fits[i]` (if any) belongs to `results[i]`.
+pub fn figure(
+    title: &str,
+    results: &[ChannelResult],
+    quantities: &[Quantity],
+    units: &[String],
+    fits: &[Option<&NoiseFit>],
+) -> Figure {
+    let mut panels = Vec::with_capacity(results.len());
+    for (i, r) in results.iter().enumerate() {
+        let q = quantities.get(i).copied().unwrap_or(Quantity::Other);
+        let (k, unit) = axis_unit(q, units.get(i).map(String::as_str).unwrap_or(""));
+        let color: Color = PALETTE[i % PALETTE.len()];
+        let tau: Vec<f64> = r.points.iter().map(|p| p.tau).collect();
+        let dev: Vec<f64> = r.points.iter().map(|p| p.dev * k).collect();
+        let lo: Vec<f64> = r.dev_lo.iter().map(|v| v * k).collect();
+        let hi: Vec<f64> = r.dev_hi.iter().map(|v| v * k).collect();
+        let (tmin, tmax) = (
+            tau.first().copied().unwrap_or(1.0),
+            tau.last().copied().unwrap_or(10.0),
+        );
+        let mut plot = LogLogPlot::new(
+            format!("{} — {}", r.name, r.estimator.name().to_uppercase()),
+            "averaging time τ (s)",
+            format!("σ(τ) ({unit})"),
+        )
+        .with_series(
+            Series::new(
+                format!("{} ({:.1} % CI)", r.name, 100.0 * r.confidence),
+                tau.clone(),
+                dev.clone(),
+            )
+            .with_ci(lo, hi)
+            .with_color(color),
+        );
+        if let Some(Some(f)) = fits.get(i) {
+            let model = Line::new(
+                "fitted model",
+                tau.clone(),
+                tau.iter().map(|&t| f.model_avar(t).sqrt() * k).collect(),
+            )
+            .with_color(Color::rgb(0x20, 0x20, 0x20));
+            plot = plot.with_line(model);
+            let grey = Color::rgb(0x70, 0x70, 0x70);
+            let mut asym = |name: &str, term: char, v: f64, coeff: f64, exp: f64, at: f64| {
+                let l = Line::power_law(name, coeff * k, exp, tmin, tmax, 32)
+                    .dashed()
+                    .with_color(grey)
+                    .with_label(term_label(term, q, v))
+                    .with_label_at(at);
+                plot.lines.push(l);
+            };
+            let geo = |a: f64, b: f64| (a * b).sqrt();
+            if let Some(t) = f.quantization {
+                asym("Q asymptote", 'Q', t.value, 3f64.sqrt() * t.value, -1.0, tmin * 2.0);
+            }
+            if let Some(t) = f.white {
+                asym("N asymptote", 'N', t.value, t.value, -0.5, geo(tmin, geo(tmin, tmax)));
+            }
+            if let Some(t) = f.bias_instability {
+                let c = (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt();
+                asym("B asymptote", 'B', t.value, c * t.value, 0.0, geo(tmin, tmax));
+            }
+            if let Some(t) = f.rate_random_walk {
+                asym("K asymptote", 'K', t.value, t.value / 3f64.sqrt(), 0.5, geo(geo(tmin, tmax), tmax));
+            }
+            if let Some(t) = f.rate_ramp {
+                asym("R asymptote", 'R', t.value, t.value / 2f64.sqrt(), 1.0, tmax / 2.0);
+            }
+            if let Some(gm) = f.gauss_markov {
+                let (s, tc) = (gm.sigma.value, gm.tau_c_s.value);
+                let y: Vec<f64> = tau
+                    .iter()
+                    .map(|&t| gauss_markov_avar(s, tc, t).sqrt() * k)
+                    .collect();
+                plot.lines.push(
+                    Line::new("Gauss-Markov term", tau.clone(), y)
+                        .dashed()
+                        .with_color(grey)
+                        .with_label(format!("GM σ = {}, T = {} s", format_sig(s * k), format_sig(tc))),
+                );
+            }
+            // Mark the curve's minimum (where bias instability is read classically).
+            if let Some((j, _)) = dev
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| v.is_finite() && **v > 0.0)
+                .min_by(|a, b| a.1.total_cmp(b.1))
+            {
+                plot = plot.with_annotation(Annotation::new("minimum", tau[j], dev[j]));
+            }
+        }
+        panels.push(plot);
+    }
+    let cols = match panels.len() {
+        0..=1 => 1,
+        2 | 4 => 2,
+        _ => 3,
+    };
+    Figure::grid(panels, cols).with_title(title)
+}
+
+/// Write the figure to `path`: `.png` → PNG (needs the `png` feature), anything else SVG.
+pub fn write(
+    path: &Path,
+    title: &str,
+    results: &[ChannelResult],
+    quantities: &[Quantity],
+    units: &[String],
+    fits: &[Option<&NoiseFit>],
+) -> Result<(), PlotError> {
+    let fig = figure(title, results, quantities, units, fits);
+    let is_png = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if is_png {
+        render_png(&fig, path)
+    } else {
+        write_svg(&fig, path)
+    }
+}

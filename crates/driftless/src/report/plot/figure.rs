@@ -1,0 +1,377 @@
+//! Plain input data for plots: what to draw, not how.
+//!
+//! These types deliberately know nothing about Allan deviations or IMUs; the
+//! caller converts its results (taus, deviations, confidence intervals, fitted
+//! noise terms) into [`Series`] and [`Line`]s. All fields are public and every
+//! type has a [`Default`], so both struct literals and the small builder
+//! methods work.
+
+/// An sRGB colour.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Color {
+    pub r: u8,
+    pub g: u8,
+    pub b: u8,
+}
+
+impl Color {
+    pub const BLACK: Color = Color::rgb(0, 0, 0);
+    pub const WHITE: Color = Color::rgb(255, 255, 255);
+    /// Dark grey used for text and model lines by default.
+    pub const DARK_GREY: Color = Color::rgb(0x33, 0x33, 0x33);
+    /// Mid grey.
+    pub const GREY: Color = Color::rgb(0x77, 0x77, 0x77);
+
+    pub const fn rgb(r: u8, g: u8, b: u8) -> Self {
+        Color { r, g, b }
+    }
+
+    /// Parses `#rrggbb` or `rrggbb` (case-insensitive). `None` on anything else.
+    pub fn from_hex(s: &str) -> Option<Self> {
+        let h = s.strip_prefix('#').unwrap_or(s);
+        if h.len() != 6 || !h.is_ascii() {
+            return None;
+        }
+        let p = |i: usize| u8::from_str_radix(&h[i..i + 2], 16).ok();
+        Some(Color::rgb(p(0)?, p(2)?, p(4)?))
+    }
+
+    /// `#rrggbb`, lower-case.
+    pub fn to_hex(self) -> String {
+        format!("#{:02x}{:02x}{:02x}", self.r, self.g, self.b)
+    }
+}
+
+/// The default series colours (Okabe–Ito, colour-blind safe; yellow omitted
+/// because it is unreadable on white). Series without an explicit colour
+/// cycle through this list in order.
+pub const PALETTE: [Color; 7] = [
+    Color::rgb(0x00, 0x72, 0xb2), // blue
+    Color::rgb(0xd5, 0x5e, 0x00), // vermillion
+    Color::rgb(0x00, 0x9e, 0x73), // bluish green
+    Color::rgb(0xcc, 0x79, 0xa7), // reddish purple
+    Color::rgb(0xe6, 0x9f, 0x00), // orange
+    Color::rgb(0x56, 0xb4, 0xe9), // sky blue
+    Color::rgb(0x00, 0x00, 0x00), // black
+];
+
+/// Marker drawn at each data point of a [`Series`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum MarkerShape {
+    #[default]
+    Circle,
+    Square,
+    Triangle,
+    Diamond,
+    /// No marker (the series is then usually drawn with `connect = true`).
+    None,
+}
+
+/// Default marker shapes, cycled like [`PALETTE`] so that series stay
+/// distinguishable in grey-scale print.
+pub const MARKER_CYCLE: [MarkerShape; 4] = [
+    MarkerShape::Circle,
+    MarkerShape::Square,
+    MarkerShape::Triangle,
+    MarkerShape::Diamond,
+];
+
+/// Stroke pattern of a [`Line`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum LineStyle {
+    #[default]
+    Solid,
+    Dashed,
+    Dotted,
+}
+
+/// Measured points: markers, an optional thin connecting line and optional
+/// confidence-interval error bars (`y_lo[i] ..= y_hi[i]` at `x[i]`).
+///
+/// Points whose coordinates are not finite and positive are skipped (log axes);
+/// if the vectors differ in length the extra elements are ignored.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Series {
+    /// Legend entry; an empty name keeps the series out of the legend.
+    pub name: String,
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    /// Lower CI bound per point (error bar bottom).
+    pub y_lo: Option<Vec<f64>>,
+    /// Upper CI bound per point (error bar top).
+    pub y_hi: Option<Vec<f64>>,
+    /// `None`: next colour of [`PALETTE`].
+    pub color: Option<Color>,
+    /// `None`: next shape of [`MARKER_CYCLE`].
+    pub marker: Option<MarkerShape>,
+    /// Join consecutive valid points with a thin line.
+    pub connect: bool,
+}
+
+impl Series {
+    /// Markers joined by a thin line, no error bars, automatic colour.
+    pub fn new(name: impl Into<String>, x: Vec<f64>, y: Vec<f64>) -> Self {
+        Series {
+            name: name.into(),
+            x,
+            y,
+            connect: true,
+            ..Default::default()
+        }
+    }
+
+    /// Adds confidence-interval error bars.
+    pub fn with_ci(mut self, y_lo: Vec<f64>, y_hi: Vec<f64>) -> Self {
+        self.y_lo = Some(y_lo);
+        self.y_hi = Some(y_hi);
+        self
+    }
+
+    pub fn with_color(mut self, color: Color) -> Self {
+        self.color = Some(color);
+        self
+    }
+
+    pub fn with_marker(mut self, marker: MarkerShape) -> Self {
+        self.marker = Some(marker);
+        self
+    }
+
+    pub fn connected(mut self, connect: bool) -> Self {
+        self.connect = connect;
+        self
+    }
+}
+
+/// A curve: a fitted model, or a per-term asymptote, optionally with a text
+/// label (e.g. `"N = 0.152 deg/√h"`) that the layout places next to the
+/// visible part of the line, away from other labels, the legend and the data.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Line {
+    /// Legend entry; an empty name keeps the line out of the legend.
+    pub name: String,
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    pub style: LineStyle,
+    /// `None`: dark grey.
+    pub color: Option<Color>,
+    /// Stroke width in px; `None`: 1.5.
+    pub width: Option<f64>,
+    /// Text drawn next to the line.
+    pub label: Option<String>,
+    /// Preferred x (data units) for the label, e.g. where the asymptote
+    /// dominates. `None`: anywhere reasonable, middle preferred.
+    pub label_x: Option<f64>,
+}
+
+impl Line {
+    pub fn new(name: impl Into<String>, x: Vec<f64>, y: Vec<f64>) -> Self {
+        Line {
+            name: name.into(),
+            x,
+            y,
+            ..Default::default()
+        }
+    }
+
+    /// The power law `y = coeff · x^exponent`, sampled at `n` log-spaced
+    /// points on `[x_min, x_max]` (asymptotes: −½ white noise, 0 flicker,
+    /// +½ random walk …). Invalid ranges give an empty (invisible) line.
+    pub fn power_law(
+        name: impl Into<String>,
+        coeff: f64,
+        exponent: f64,
+        x_min: f64,
+        x_max: f64,
+        n: usize,
+    ) -> Self {
+        let mut line = Line::new(name, Vec::new(), Vec::new());
+        let ok = x_min.is_finite() && x_max.is_finite() && x_min > 0.0 && x_max > x_min;
+        if ok && n > 0 {
+            let n = n.max(2);
+            let (a, b) = (x_min.log10(), x_max.log10());
+            for i in 0..n {
+                let x = 10f64.powf(a + (b - a) * i as f64 / (n - 1) as f64);
+                line.x.push(x);
+                line.y.push(coeff * x.powf(exponent));
+            }
+        }
+        line
+    }
+
+    pub fn dashed(mut self) -> Self {
+        self.style = LineStyle::Dashed;
+        self
+    }
+
+    pub fn with_style(mut self, style: LineStyle) -> Self {
+        self.style = style;
+        self
+    }
+
+    pub fn with_color(mut self, color: Color) -> Self {
+        self.color = Some(color);
+        self
+    }
+
+    pub fn with_width(mut self, width: f64) -> Self {
+        self.width = Some(width);
+        self
+    }
+
+    pub fn with_label(mut self, label: impl Into<String>) -> Self {
+        self.label = Some(label.into());
+        self
+    }
+
+    /// Preferred x position (data units) of the label.
+    pub fn with_label_at(mut self, x: f64) -> Self {
+        self.label_x = Some(x);
+        self
+    }
+}
+
+/// Free text at a data point, optionally with a small open-circle marker
+/// (e.g. "bias instability" at the minimum of the curve).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Annotation {
+    pub text: String,
+    pub x: f64,
+    pub y: f64,
+    pub marker: bool,
+    /// `None`: dark grey.
+    pub color: Option<Color>,
+}
+
+impl Annotation {
+    pub fn new(text: impl Into<String>, x: f64, y: f64) -> Self {
+        Annotation {
+            text: text.into(),
+            x,
+            y,
+            marker: true,
+            color: None,
+        }
+    }
+}
+
+/// Where a panel's legend goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum LegendPosition {
+    /// The inside corner that hides the least data.
+    #[default]
+    Auto,
+    TopLeft,
+    TopRight,
+    BottomLeft,
+    BottomRight,
+    Hidden,
+}
+
+/// One log-log panel.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LogLogPlot {
+    pub title: String,
+    /// Axis title including the unit, e.g. `"τ (s)"`.
+    pub x_label: String,
+    /// Axis title including the unit, e.g. `"σ(τ) (deg/h)"`.
+    pub y_label: String,
+    pub series: Vec<Series>,
+    pub lines: Vec<Line>,
+    pub annotations: Vec<Annotation>,
+    /// Fixed x range (data units). `None`: fitted to the series (and, if
+    /// there are no series, the lines), with a small margin.
+    pub x_range: Option<(f64, f64)>,
+    /// Fixed y range (data units), as `x_range`.
+    pub y_range: Option<(f64, f64)>,
+    pub legend: LegendPosition,
+}
+
+impl LogLogPlot {
+    pub fn new(
+        title: impl Into<String>,
+        x_label: impl Into<String>,
+        y_label: impl Into<String>,
+    ) -> Self {
+        LogLogPlot {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            ..Default::default()
+        }
+    }
+
+    pub fn with_series(mut self, series: Series) -> Self {
+        self.series.push(series);
+        self
+    }
+
+    pub fn with_line(mut self, line: Line) -> Self {
+        self.lines.push(line);
+        self
+    }
+
+    pub fn with_annotation(mut self, annotation: Annotation) -> Self {
+        self.annotations.push(annotation);
+        self
+    }
+}
+
+/// Default size of one panel in px (CSS px in SVG; PNG multiplies by its
+/// scale factor).
+pub const DEFAULT_PANEL_SIZE: (f64, f64) = (640.0, 480.0);
+
+/// One or more panels on a grid, with an optional overall title.
+///
+/// A six-axis IMU report is typically `Figure::grid(vec![gyro, accel], 2)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    pub title: Option<String>,
+    pub panels: Vec<LogLogPlot>,
+    /// Panels per row; `0` means all in one row.
+    pub columns: usize,
+    /// Size of each panel cell in px.
+    pub panel_width: f64,
+    pub panel_height: f64,
+}
+
+impl Default for Figure {
+    fn default() -> Self {
+        Figure {
+            title: None,
+            panels: Vec::new(),
+            columns: 0,
+            panel_width: DEFAULT_PANEL_SIZE.0,
+            panel_height: DEFAULT_PANEL_SIZE.1,
+        }
+    }
+}
+
+impl Figure {
+    pub fn single(plot: LogLogPlot) -> Self {
+        Figure {
+            panels: vec![plot],
+            ..Default::default()
+        }
+    }
+
+    /// Panels laid out row-major, `columns` per row (`0`: one row).
+    pub fn grid(panels: Vec<LogLogPlot>, columns: usize) -> Self {
+        Figure {
+            panels,
+            columns,
+            ..Default::default()
+        }
+    }
+
+    pub fn with_title(mut self, title: impl Into<String>) -> Self {
+        self.title = Some(title.into());
+        self
+    }
+
+    pub fn with_panel_size(mut self, width: f64, height: f64) -> Self {
+        self.panel_width = width;
+        self.panel_height = height;
+        self
+    }
+}
