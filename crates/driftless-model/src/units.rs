@@ -20,6 +20,8 @@ pub const M_PER_S_PER_SQRT_H: f64 = 1.0 / 60.0;
 pub const MILLI_G: f64 = STANDARD_GRAVITY * 1e-3;
 /// 1 µg in m/s².
 pub const MICRO_G: f64 = STANDARD_GRAVITY * 1e-6;
+/// 0 °C in kelvin (°C = K − 273.15).
+pub const KELVIN_OFFSET: f64 = 273.15;
 
 #[cfg(test)]
 mod tests {

@@ -41,8 +41,23 @@ pub struct Channel {
     pub values: Vec<f64>,
 }
 
+/// A gap in the time column: the interval between two consecutive rows exceeded the
+/// gap threshold (`gap_factor × τ0`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TimeGap {
+    /// Index of the first row after the gap (the gap lies between rows `index - 1` and `index`).
+    pub index: usize,
+    /// Time stamp of the row before the gap, s.
+    pub start_s: f64,
+    /// Length of the interval `t[index] - t[index - 1]`, s.
+    pub duration_s: f64,
+}
+
 /// A columnar log: optional time stamps plus data channels of equal length.
-#[derive(Clone, Debug, PartialEq)]
+///
+/// Build one with [`ImuLog::new`] (or `ImuLog { .., ..Default::default() }`) so that
+/// fields added later keep their neutral defaults.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ImuLog {
     /// Where it came from (file path or `simulated:…`).
     pub source: String,
@@ -52,9 +67,45 @@ pub struct ImuLog {
     pub tau0_s: f64,
     /// Data channels, equal lengths.
     pub channels: Vec<Channel>,
+    /// Contiguous row ranges to analyse independently. One full range `0..len` when the
+    /// log has no gaps or gaps were bridged; several when a reader split at gaps
+    /// ([`crate::io::GapPolicy::Split`]). Empty only for an empty log.
+    pub segments: Vec<std::ops::Range<usize>>,
+    /// Time gaps found by the reader (with `GapPolicy::Split` or `GapPolicy::Bridge`), in
+    /// row order; callers should warn about them. Empty when there were none.
+    pub gaps: Vec<TimeGap>,
 }
 
 impl ImuLog {
+    /// A log with one full-range segment and no gaps.
+    pub fn new(
+        source: impl Into<String>,
+        time_s: Option<Vec<f64>>,
+        tau0_s: f64,
+        channels: Vec<Channel>,
+    ) -> Self {
+        let n = channels
+            .first()
+            .map(|c| c.values.len())
+            .or_else(|| time_s.as_ref().map(Vec::len))
+            .unwrap_or(0);
+        ImuLog {
+            source: source.into(),
+            time_s,
+            tau0_s,
+            channels,
+            segments: if n > 0 {
+                std::iter::once(0..n).collect()
+            } else {
+                Vec::new()
+            },
+            gaps: Vec::new(),
+        }
+    }
+    /// The channel with this name, if any.
+    pub fn channel(&self, name: &str) -> Option<&Channel> {
+        self.channels.iter().find(|c| c.name == name)
+    }
     /// Number of samples per channel.
     pub fn len(&self) -> usize {
         self.channels.first().map(|c| c.values.len()).unwrap_or(0)

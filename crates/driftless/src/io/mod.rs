@@ -1,6 +1,50 @@
 //! Readers and writers. Readers turn files into typed, columnar [`log::ImuLog`]s and
 //! never do math beyond unit conversion at the edge; algorithms never parse files.
 //!
+//! * [`text`]: delimited text (CSV, whitespace, tab, semicolon), streamed and parsed in parallel.
+//! * [`binary`]: the compact `DRIFTLOG` column-major binary format (reader and writer).
+//! * [`write`]: CSV writer.
+//! * [`units`]: unit strings → SI conversion.
+//! * [`error`]: one error type, [`LogError`], naming file, line and column.
+//!
 //! OWNER: helper "io" (text, binary, units, errors, fuzzing).
 
+pub mod binary;
+pub mod error;
 pub mod log;
+mod number;
+pub mod text;
+pub mod units;
+pub mod write;
+
+pub use binary::{read_binary, read_binary_file, write_binary, write_binary_file};
+pub use error::{Location, LogError};
+pub use log::{Channel, ImuLog, Quantity, TimeGap};
+pub use text::{
+    ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, TextOptions, read_text,
+    read_text_bytes, read_text_file,
+};
+pub use units::{TimeUnit, Unit};
+pub use write::{write_csv, write_csv_file};
+
+/// Reads a log file, choosing the reader by content: files starting with the `DRIFTLOG`
+/// magic are read as binary logs (`opts` is then ignored), anything else as delimited text.
+pub fn read_log_file(
+    path: impl AsRef<std::path::Path>,
+    opts: &TextOptions,
+) -> Result<ImuLog, LogError> {
+    use std::io::Read;
+    let path = path.as_ref();
+    let mut magic = Vec::with_capacity(8);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(8).read_to_end(&mut magic))
+        .map_err(|error| LogError::Io {
+            path: path.display().to_string(),
+            error,
+        })?;
+    if magic.as_slice() == binary::MAGIC {
+        read_binary_file(path)
+    } else {
+        read_text_file(path, opts)
+    }
+}

@@ -1,0 +1,362 @@
+//! Reader and writer errors.
+//!
+//! Every error names the input and, where the problem sits on a line, the place:
+//! `PATH:LINE:COL: message`. LINE is 1-based. COL is the 1-based **byte** column of the
+//! start of the offending field (what editors and compilers use to jump to a spot); the
+//! message itself names the 1-based **field number** and the column's name, e.g.
+//! `imu.csv:12:17: non-numeric value "abc" in column 3 (gyro_y)`. Problems that concern a
+//! whole row (time order, gaps) name the line and the time column's field number but no
+//! byte column; problems with the options or the whole input name only the input.
+
+use std::fmt;
+
+/// Where an error was found: the input's display name, and a line and byte column when
+/// they apply.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Location {
+    /// File path or other display name of the input.
+    pub path: String,
+    /// 1-based line number, if the error concerns one line.
+    pub line: Option<usize>,
+    /// 1-based byte column of the offending field, if the error concerns one field.
+    pub column: Option<usize>,
+}
+
+impl Location {
+    /// The whole input.
+    pub fn input(path: &str) -> Self {
+        Location {
+            path: path.to_owned(),
+            line: None,
+            column: None,
+        }
+    }
+    /// One line of the input.
+    pub fn line(path: &str, line: usize) -> Self {
+        Location {
+            path: path.to_owned(),
+            line: Some(line),
+            column: None,
+        }
+    }
+    /// One field of one line.
+    pub fn field(path: &str, line: usize, column: usize) -> Self {
+        Location {
+            path: path.to_owned(),
+            line: Some(line),
+            column: Some(column),
+        }
+    }
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.path)?;
+        if let Some(line) = self.line {
+            write!(f, ":{line}")?;
+            if let Some(col) = self.column {
+                write!(f, ":{col}")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why reading or writing a log failed. One error per failed read; a failed read never
+/// returns partial data.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum LogError {
+    /// The operating system failed to open, read or write the input/output.
+    #[error("{path}: {error}")]
+    Io {
+        /// Input or output display name.
+        path: String,
+        /// Underlying error.
+        #[source]
+        error: std::io::Error,
+    },
+    /// A field that should hold a number does not.
+    #[error("{at}: non-numeric value {value:?} in column {field} ({name})")]
+    NonNumeric {
+        /// Where.
+        at: Location,
+        /// The offending text (shortened when long, lossy UTF-8).
+        value: String,
+        /// 1-based field number.
+        field: usize,
+        /// Column name.
+        name: String,
+    },
+    /// A field is empty (two delimiters in a row).
+    #[error("{at}: empty value in column {field} ({name})")]
+    EmptyField {
+        /// Where.
+        at: Location,
+        /// 1-based field number.
+        field: usize,
+        /// Column name.
+        name: String,
+    },
+    /// NaN, infinity, or a number too large for f64.
+    #[error(
+        "{at}: non-finite value {value:?} in column {field} ({name}); NaN and infinity are not valid samples"
+    )]
+    NonFinite {
+        /// Where.
+        at: Location,
+        /// The offending text.
+        value: String,
+        /// 1-based field number.
+        field: usize,
+        /// Column name.
+        name: String,
+    },
+    /// A row with a different number of fields than the header / first row.
+    #[error("{at}: row has {found} fields, expected {expected} (as on line {reference_line})")]
+    Ragged {
+        /// Where (the column is where the extra field starts or where the line ends).
+        at: Location,
+        /// Fields found on this row (counting stops at `expected + 1`).
+        found: usize,
+        /// Fields on the reference row.
+        expected: usize,
+        /// Line of the header or first data row that fixed the field count.
+        reference_line: usize,
+    },
+    /// A time stamp smaller than its predecessor.
+    #[error(
+        "{at}: time goes backwards in column {field} ({name}): {time_s} s after {previous_s} s"
+    )]
+    NonMonotonicTime {
+        /// Where.
+        at: Location,
+        /// 1-based field number of the time column.
+        field: usize,
+        /// Time column name.
+        name: String,
+        /// Time on this row, s.
+        time_s: f64,
+        /// Time on the previous data row, s.
+        previous_s: f64,
+    },
+    /// A time stamp equal to its predecessor.
+    #[error(
+        "{at}: duplicated time stamp {time_s} s in column {field} ({name}), same as the previous data row"
+    )]
+    DuplicateTime {
+        /// Where.
+        at: Location,
+        /// 1-based field number of the time column.
+        field: usize,
+        /// Time column name.
+        name: String,
+        /// The repeated time, s.
+        time_s: f64,
+    },
+    /// A gap in time larger than the configured factor times τ0 (with `GapPolicy::Error`).
+    #[error(
+        "{at}: time gap of {duration_s} s before this row ({ratio:.1} × τ0 = {tau0_s} s, limit {gap_factor} × τ0) in column {field} ({name}); choose gap policy `split` or `bridge` to accept gaps"
+    )]
+    TimeGap {
+        /// Where (the first row after the gap).
+        at: Location,
+        /// 1-based field number of the time column.
+        field: usize,
+        /// Time column name.
+        name: String,
+        /// Length of the interval, s.
+        duration_s: f64,
+        /// `duration_s / tau0_s`.
+        ratio: f64,
+        /// Nominal interval, s.
+        tau0_s: f64,
+        /// The configured limit factor.
+        gap_factor: f64,
+    },
+    /// The time column's median interval disagrees with the given rate.
+    #[error(
+        "{at}: rate {rate_hz} Hz given, but the time column's median interval is {median_dt_s} s ({measured_hz} Hz); they differ by more than {tolerance_pct} %"
+    )]
+    RateMismatch {
+        /// The input.
+        at: Location,
+        /// Rate the caller gave, Hz.
+        rate_hz: f64,
+        /// Median time-stamp difference, s.
+        median_dt_s: f64,
+        /// `1 / median_dt_s`, Hz.
+        measured_hz: f64,
+        /// Allowed relative difference, %.
+        tolerance_pct: f64,
+    },
+    /// No data rows at all (empty, blank or comment-only input).
+    #[error("{at}: no data rows (the input is empty or holds only comments and blank lines)")]
+    Empty {
+        /// The input.
+        at: Location,
+    },
+    /// A header but no data rows.
+    #[error("{at}: header row but no data rows")]
+    HeaderOnly {
+        /// The header's line.
+        at: Location,
+    },
+    /// A unit string that is not recognised.
+    #[error("{at}: unknown unit {unit:?} for column {column}; known units: {known}")]
+    UnknownUnit {
+        /// Where the unit came from (the input for options, the header line for header hints).
+        at: Location,
+        /// The unit text.
+        unit: String,
+        /// Which column it was for.
+        column: String,
+        /// List of accepted units.
+        known: &'static str,
+    },
+    /// A column name or index the caller asked for that the input does not have.
+    #[error("{at}: no column {column} (columns: {available})")]
+    UnknownColumn {
+        /// The input (the header line when there is one).
+        at: Location,
+        /// The requested name or `#index`.
+        column: String,
+        /// The columns the input has.
+        available: String,
+    },
+    /// Options that contradict each other or the input.
+    #[error("{at}: {message}")]
+    InvalidOptions {
+        /// The input.
+        at: Location,
+        /// What is wrong.
+        message: String,
+    },
+    /// Binary log: not a driftless binary log.
+    #[error("{at}: not a driftless binary log (bad magic {found:?}, expected \"DRIFTLOG\")")]
+    BadMagic {
+        /// The input.
+        at: Location,
+        /// The first bytes found (lossy).
+        found: String,
+    },
+    /// Binary log: a format version this build does not read.
+    #[error(
+        "{at}: unsupported driftless binary log version {version} (this build reads version {supported})"
+    )]
+    UnsupportedVersion {
+        /// The input.
+        at: Location,
+        /// Version in the file.
+        version: u32,
+        /// Version this build reads.
+        supported: u32,
+    },
+    /// Binary log: the header text is malformed or inconsistent.
+    #[error("{at}: bad binary log header: {message}")]
+    BadHeader {
+        /// The input.
+        at: Location,
+        /// What is wrong.
+        message: String,
+    },
+    /// Binary log: the input ends before the header says it should.
+    #[error("{at}: truncated binary log: {message}")]
+    Truncated {
+        /// The input.
+        at: Location,
+        /// What was missing.
+        message: String,
+    },
+    /// Binary log: the data size disagrees with the header's row and column counts.
+    #[error(
+        "{at}: binary log size mismatch: header says {rows} rows × {columns} columns = {expected_bytes} bytes of data, found {found_bytes}"
+    )]
+    CountMismatch {
+        /// The input.
+        at: Location,
+        /// Rows in the header.
+        rows: usize,
+        /// Columns (time included) in the header.
+        columns: usize,
+        /// Bytes of data the header implies.
+        expected_bytes: u64,
+        /// Bytes of data present.
+        found_bytes: u64,
+    },
+    /// Binary log: a stored sample is NaN or infinite.
+    #[error("{at}: non-finite value in binary log column {column}, row {row}")]
+    NonFiniteStored {
+        /// The input.
+        at: Location,
+        /// Column name.
+        column: String,
+        /// 0-based row.
+        row: usize,
+    },
+    /// Binary log: the data contradict the format's invariants (time order, segments).
+    #[error("{at}: corrupt binary log: {message}")]
+    Corrupt {
+        /// The input.
+        at: Location,
+        /// What is wrong.
+        message: String,
+    },
+    /// Writer: the log itself is inconsistent (channel lengths differ, …).
+    #[error("{at}: cannot write log: {message}")]
+    InvalidLog {
+        /// The output.
+        at: Location,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl LogError {
+    /// The location the error names.
+    pub fn location(&self) -> Option<&Location> {
+        use LogError::*;
+        match self {
+            Io { .. } => None,
+            NonNumeric { at, .. }
+            | EmptyField { at, .. }
+            | NonFinite { at, .. }
+            | Ragged { at, .. }
+            | NonMonotonicTime { at, .. }
+            | DuplicateTime { at, .. }
+            | TimeGap { at, .. }
+            | RateMismatch { at, .. }
+            | Empty { at }
+            | HeaderOnly { at }
+            | UnknownUnit { at, .. }
+            | UnknownColumn { at, .. }
+            | InvalidOptions { at, .. }
+            | BadMagic { at, .. }
+            | UnsupportedVersion { at, .. }
+            | BadHeader { at, .. }
+            | Truncated { at, .. }
+            | CountMismatch { at, .. }
+            | NonFiniteStored { at, .. }
+            | Corrupt { at, .. }
+            | InvalidLog { at, .. } => Some(at),
+        }
+    }
+
+    /// The 1-based line the error names, if any.
+    pub fn line(&self) -> Option<usize> {
+        self.location().and_then(|l| l.line)
+    }
+}
+
+/// Shortens and sanitises user text for an error message.
+pub(crate) fn excerpt(bytes: &[u8]) -> String {
+    const MAX: usize = 40;
+    let s = String::from_utf8_lossy(bytes);
+    if s.chars().count() > MAX {
+        let mut t: String = s.chars().take(MAX).collect();
+        t.push('…');
+        t
+    } else {
+        s.into_owned()
+    }
+}

@@ -1,0 +1,1317 @@
+//! Delimited text reader: CSV, semicolon, tab or whitespace separated IMU logs.
+//!
+//! * Delimiter: auto-detected from the first non-comment row (`;` if present, else `,`,
+//!   else tab if the row splits cleanly on tabs, else runs of whitespace), or given.
+//! * `#` starts a comment, on its own line or after the data; blank lines are skipped;
+//!   `\r\n` line ends are accepted; one trailing delimiter per row is tolerated.
+//! * Header: auto-detected (a first non-comment row with a non-numeric field), forced
+//!   on or off, or names given by the caller. A header name may carry its unit in
+//!   brackets, `gyro_x [deg/s]` or `tick(ms)`; it is used when the caller gives none.
+//! * Columns: a time column (by name or 1-based index) or none; the data columns to keep
+//!   (by name or index) each with its [`Unit`]; unselected columns are only counted, never
+//!   parsed. Values are converted to SI while parsing, the only math a reader does.
+//! * τ0: the median time-stamp difference when there is a time column (a given rate must
+//!   agree within `rate_tolerance`), else `1 / rate_hz`.
+//!
+//! Streaming: the input is read in chunks of [`TextOptions::chunk_bytes`] (16 MiB), cut at
+//! the last line end, split into one piece per rayon thread at line ends and parsed in
+//! parallel; the pieces' columns are appended in order. Output vectors are pre-sized from the
+//! file size and the first chunk's bytes per row. Peak memory is the parsed columns plus
+//! about two chunks (plus 8 bytes per row for the median τ0 at the end).
+//!
+//! Errors: the first problem in file order, as one [`LogError`] naming path, line and column
+//! (see [`super::error`]).
+
+use std::fmt;
+use std::io::Read;
+use std::ops::Range;
+use std::path::Path;
+use std::str::FromStr;
+
+use rayon::prelude::*;
+
+use super::error::{Location, LogError, excerpt};
+use super::log::{Channel, ImuLog, TimeGap};
+use super::number::{parse_f64, parse_prefix};
+use super::units::{KNOWN_UNITS, TimeUnit, Unit};
+
+/// Field separator.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Delimiter {
+    /// Detect from the first non-comment row.
+    #[default]
+    Auto,
+    /// `,`
+    Comma,
+    /// `;`
+    Semicolon,
+    /// A single tab between fields (spaces around fields are trimmed).
+    Tab,
+    /// Runs of spaces and/or tabs; leading and trailing whitespace ignored.
+    Whitespace,
+}
+
+/// Whether the first non-comment row names the columns.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum HeaderMode {
+    /// A header if the first non-comment row has a non-empty, non-numeric field.
+    #[default]
+    Auto,
+    /// The first non-comment row is a header.
+    Present,
+    /// There is no header; every non-comment row is data.
+    Absent,
+}
+
+/// A column, by 1-based field number or by name.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ColumnRef {
+    /// 1-based field number.
+    Index(usize),
+    /// Name from the header or from [`TextOptions::column_names`] (exact match, then a
+    /// unique case-insensitive match).
+    Name(String),
+}
+
+/// What to do when consecutive time stamps are further apart than
+/// `gap_factor × τ0`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GapPolicy {
+    /// Fail with [`LogError::TimeGap`].
+    #[default]
+    Error,
+    /// Keep all rows; [`ImuLog::segments`] lists the contiguous runs between gaps and
+    /// [`ImuLog::gaps`] the gaps.
+    Split,
+    /// Keep all rows as one segment; [`ImuLog::gaps`] lists the gaps so the caller can warn.
+    Bridge,
+}
+
+/// One data column to keep: which, in what unit, and optionally under which name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ColumnSpec {
+    /// Which column of the input.
+    pub column: ColumnRef,
+    /// Its unit; `None` takes the header's bracketed unit, then
+    /// [`TextOptions::default_unit`], then unitless.
+    pub unit: Option<Unit>,
+    /// Channel name in the log; `None` keeps the input's name (`colN` without a header).
+    pub rename: Option<String>,
+}
+
+/// Reader options. `TextOptions::default()` auto-detects everything, keeps every column
+/// unitless, and needs either a time column or `rate_hz` to know τ0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextOptions {
+    /// Field separator.
+    pub delimiter: Delimiter,
+    /// Header detection.
+    pub header: HeaderMode,
+    /// Column names from the caller, one per field. Used instead of the header's names
+    /// when there is a header, and instead of `col1`, `col2`, … when there is none.
+    pub column_names: Option<Vec<String>>,
+    /// The time column, or `None` for a log without time stamps (then `rate_hz` is needed).
+    pub time_column: Option<ColumnRef>,
+    /// Unit of the time column; `None` takes the header's bracketed unit, else seconds.
+    pub time_unit: Option<TimeUnit>,
+    /// Data columns to keep, in output order. Empty keeps every column except time.
+    pub columns: Vec<ColumnSpec>,
+    /// Unit for kept columns with neither an explicit nor a header unit.
+    pub default_unit: Option<Unit>,
+    /// Sample rate, Hz. Required without a time column (τ0 = 1 / rate); with one it must
+    /// agree with the median interval within `rate_tolerance`.
+    pub rate_hz: Option<f64>,
+    /// Allowed relative difference between `rate_hz` and the time column's rate (0.02 = 2 %).
+    pub rate_tolerance: f64,
+    /// What to do with time gaps.
+    pub gap_policy: GapPolicy,
+    /// An interval longer than `gap_factor × τ0` is a gap (1.5 by default).
+    pub gap_factor: f64,
+    /// Bytes read per chunk (16 MiB by default; minimum 64).
+    pub chunk_bytes: usize,
+}
+
+impl Default for TextOptions {
+    fn default() -> Self {
+        TextOptions {
+            delimiter: Delimiter::Auto,
+            header: HeaderMode::Auto,
+            column_names: None,
+            time_column: None,
+            time_unit: None,
+            columns: Vec::new(),
+            default_unit: None,
+            rate_hz: None,
+            rate_tolerance: 0.02,
+            gap_policy: GapPolicy::Error,
+            gap_factor: 1.5,
+            chunk_bytes: 16 << 20,
+        }
+    }
+}
+
+impl TextOptions {
+    /// Sets the time column.
+    pub fn with_time(mut self, column: ColumnRef, unit: Option<TimeUnit>) -> Self {
+        self.time_column = Some(column);
+        self.time_unit = unit;
+        self
+    }
+    /// Sets the sample rate, Hz.
+    pub fn with_rate_hz(mut self, rate_hz: f64) -> Self {
+        self.rate_hz = Some(rate_hz);
+        self
+    }
+    /// Adds a data column to keep.
+    pub fn with_column(mut self, column: ColumnRef, unit: Option<Unit>) -> Self {
+        self.columns.push(ColumnSpec {
+            column,
+            unit,
+            rename: None,
+        });
+        self
+    }
+    /// Sets the column names.
+    pub fn with_names<S: Into<String>>(mut self, names: impl IntoIterator<Item = S>) -> Self {
+        self.column_names = Some(names.into_iter().map(Into::into).collect());
+        self
+    }
+    /// Sets the gap policy.
+    pub fn with_gap_policy(mut self, policy: GapPolicy) -> Self {
+        self.gap_policy = policy;
+        self
+    }
+}
+
+/// A `--column`-style specification that could not be parsed.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("bad column specification {text:?}: {reason}")]
+pub struct ParseSpecError {
+    /// The text given.
+    pub text: String,
+    /// Why it was rejected.
+    pub reason: String,
+}
+
+impl FromStr for ColumnRef {
+    type Err = ParseSpecError;
+    /// All digits → 1-based index (0 is rejected); anything else → name.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let t = s.trim();
+        if t.is_empty() {
+            return Err(ParseSpecError {
+                text: s.into(),
+                reason: "empty column reference".into(),
+            });
+        }
+        if t.bytes().all(|b| b.is_ascii_digit()) {
+            match t.parse::<usize>() {
+                Ok(i) if i >= 1 => Ok(ColumnRef::Index(i)),
+                _ => Err(ParseSpecError {
+                    text: s.into(),
+                    reason: "column numbers are 1-based".into(),
+                }),
+            }
+        } else {
+            Ok(ColumnRef::Name(t.to_owned()))
+        }
+    }
+}
+
+impl fmt::Display for ColumnRef {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ColumnRef::Index(i) => write!(f, "#{i}"),
+            ColumnRef::Name(n) => write!(f, "{n:?}"),
+        }
+    }
+}
+
+impl FromStr for ColumnSpec {
+    type Err = ParseSpecError;
+    /// `COLUMN[:UNIT][=NEW_NAME]`, e.g. `gyro_x:deg/s`, `2:counts/6258rad/s=gyro_x`, `5`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let (body, rename) = match s.rsplit_once('=') {
+            Some((b, r)) if !r.trim().is_empty() => (b, Some(r.trim().to_owned())),
+            _ => (s, None),
+        };
+        let (col, unit) = match body.split_once(':') {
+            Some((c, u)) => (c, Some(u)),
+            None => (body, None),
+        };
+        let column = col.parse()?;
+        let unit = unit
+            .map(|u| {
+                Unit::parse(u).map_err(|e| ParseSpecError {
+                    text: s.into(),
+                    reason: e.to_string(),
+                })
+            })
+            .transpose()?;
+        Ok(ColumnSpec {
+            column,
+            unit,
+            rename,
+        })
+    }
+}
+
+impl FromStr for GapPolicy {
+    type Err = ParseSpecError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "error" => Ok(GapPolicy::Error),
+            "split" => Ok(GapPolicy::Split),
+            "bridge" => Ok(GapPolicy::Bridge),
+            _ => Err(ParseSpecError {
+                text: s.into(),
+                reason: "expected error, split or bridge".into(),
+            }),
+        }
+    }
+}
+
+impl FromStr for Delimiter {
+    type Err = ParseSpecError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "auto" => Ok(Delimiter::Auto),
+            "," | "comma" => Ok(Delimiter::Comma),
+            ";" | "semicolon" => Ok(Delimiter::Semicolon),
+            "\t" | "\\t" | "tab" => Ok(Delimiter::Tab),
+            " " | "space" | "whitespace" | "ws" => Ok(Delimiter::Whitespace),
+            _ => Err(ParseSpecError {
+                text: s.into(),
+                reason: "expected auto, comma, semicolon, tab or whitespace".into(),
+            }),
+        }
+    }
+}
+
+/// Reads a delimited text log from a file (streamed, never loaded whole).
+pub fn read_text_file(path: impl AsRef<Path>, opts: &TextOptions) -> Result<ImuLog, LogError> {
+    let path = path.as_ref();
+    let name = path.display().to_string();
+    let io = |error| LogError::Io {
+        path: name.clone(),
+        error,
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let size = file.metadata().map_err(io)?.len();
+    read_impl(file, &name, opts, Some(size))
+}
+
+/// Reads a delimited text log from any reader; `source` names it in errors and in
+/// [`ImuLog::source`].
+pub fn read_text<R: Read>(reader: R, source: &str, opts: &TextOptions) -> Result<ImuLog, LogError> {
+    read_impl(reader, source, opts, None)
+}
+
+/// Reads a delimited text log held in memory.
+pub fn read_text_bytes(bytes: &[u8], source: &str, opts: &TextOptions) -> Result<ImuLog, LogError> {
+    read_impl(bytes, source, opts, Some(bytes.len() as u64))
+}
+
+// ---------------------------------------------------------------------------------------
+// Internals
+// ---------------------------------------------------------------------------------------
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Delim {
+    Byte(u8),
+    Whitespace,
+}
+
+#[inline]
+fn is_ws(b: u8) -> bool {
+    b == b' ' || b == b'\t' || b == b'\r' || b == b'\x0b' || b == b'\x0c'
+}
+
+/// Calls `f(byte_offset, field)` for each field of a line (comment already allowed),
+/// returns the number of fields. Empty trailing field after a final delimiter is dropped.
+#[inline]
+fn for_each_field<E>(
+    line: &[u8],
+    delim: Delim,
+    mut f: impl FnMut(usize, usize, &[u8]) -> Result<(), E>,
+) -> Result<usize, E> {
+    let n = line.len();
+    let mut p = 0;
+    let mut field = 0;
+    match delim {
+        Delim::Whitespace => loop {
+            while p < n && is_ws(line[p]) {
+                p += 1;
+            }
+            if p >= n || line[p] == b'#' {
+                break;
+            }
+            let start = p;
+            while p < n && !is_ws(line[p]) && line[p] != b'#' {
+                p += 1;
+            }
+            f(field, start, &line[start..p])?;
+            field += 1;
+        },
+        Delim::Byte(d) => loop {
+            let start = p;
+            while p < n && line[p] != d && line[p] != b'#' {
+                p += 1;
+            }
+            let end_of_row = p >= n || line[p] == b'#';
+            let (mut s, mut e) = (start, p);
+            while s < e && is_ws(line[s]) {
+                s += 1;
+            }
+            while e > s && is_ws(line[e - 1]) {
+                e -= 1;
+            }
+            if end_of_row && s == e && field > 0 {
+                break; // one trailing delimiter
+            }
+            f(field, s, &line[s..e])?;
+            field += 1;
+            if end_of_row {
+                break;
+            }
+            p += 1;
+        },
+    }
+    Ok(field)
+}
+
+/// True when the line holds no data (blank or comment).
+#[inline]
+fn is_blank_or_comment(line: &[u8]) -> bool {
+    match line.iter().position(|&b| !is_ws(b)) {
+        None => true,
+        Some(i) => line[i] == b'#',
+    }
+}
+
+/// Splits a buffer into lines without the `\n` and a trailing `\r`.
+fn lines(buf: &[u8]) -> impl Iterator<Item = &[u8]> {
+    let body = buf.strip_suffix(b"\n").unwrap_or(buf);
+    let mut it = (!buf.is_empty()).then(|| body.split(|&b| b == b'\n'));
+    std::iter::from_fn(move || it.as_mut()?.next()).map(|l| l.strip_suffix(b"\r").unwrap_or(l))
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    out: usize,
+    scale: f64,
+    offset: f64,
+}
+
+#[derive(Debug)]
+struct Plan {
+    delim: Delim,
+    nfields: usize,
+    /// Line that fixed the field count (header or first data row).
+    reference_line: usize,
+    names: Vec<String>,
+    slots: Vec<Option<Slot>>,
+    /// Output vectors: time (if any) first, then channels.
+    nout: usize,
+    time_field: Option<usize>,
+    channels: Vec<(usize, String, Unit)>,
+    header_line: Option<usize>,
+}
+
+enum FieldErr {
+    NonNumeric { field: usize, value: String },
+    Empty { field: usize },
+    NonFinite { field: usize, value: String },
+    Ragged { found: usize },
+}
+
+struct PieceErr {
+    /// 0-based line within the piece.
+    line: usize,
+    /// 1-based byte column.
+    col: usize,
+    kind: FieldErr,
+}
+
+struct PieceOut {
+    cols: Vec<Vec<f64>>,
+    rows: usize,
+    lines: usize,
+    /// (row within piece, line within piece) where the row→line offset changes.
+    anchors: Vec<(usize, usize)>,
+}
+
+/// Parses one data line into `cols`. `Ok(false)` for blank/comment lines.
+#[inline]
+fn parse_line(line: &[u8], plan: &Plan, cols: &mut [Vec<f64>]) -> Result<bool, (usize, FieldErr)> {
+    if is_blank_or_comment(line) {
+        return Ok(false);
+    }
+    let mut extra_at = None;
+    let found = for_each_field(line, plan.delim, |field, start, text| {
+        let Some(slot) = plan.slots.get(field) else {
+            extra_at.get_or_insert(start);
+            return Ok(());
+        };
+        if let Some(slot) = slot {
+            if text.is_empty() {
+                return Err((start + 1, FieldErr::Empty { field: field + 1 }));
+            }
+            let raw = parse_f64(text).ok_or_else(|| {
+                (
+                    start + 1,
+                    FieldErr::NonNumeric {
+                        field: field + 1,
+                        value: excerpt(text),
+                    },
+                )
+            })?;
+            let v = (raw - slot.offset) * slot.scale;
+            if !v.is_finite() {
+                return Err((
+                    start + 1,
+                    FieldErr::NonFinite {
+                        field: field + 1,
+                        value: excerpt(text),
+                    },
+                ));
+            }
+            if let Some(c) = cols.get_mut(slot.out) {
+                c.push(v);
+            }
+        }
+        Ok(())
+    })?;
+    if found != plan.nfields {
+        let col = extra_at.unwrap_or(line.len()) + 1;
+        return Err((col, FieldErr::Ragged { found }));
+    }
+    Ok(true)
+}
+
+/// Fast path for one plain data row starting at `p` (no comment, only the number forms
+/// of [`parse_prefix`], single spaces/tabs): pushes one value per output column and returns
+/// the offset after the row's line end. `None` sends the row to the general path
+/// ([`parse_line`]), which accepts a superset, gives identical values and builds errors.
+#[inline]
+fn fast_row(b: &[u8], mut p: usize, plan: &Plan, cols: &mut [Vec<f64>]) -> Option<usize> {
+    let n = b.len();
+    let last = plan.nfields.checked_sub(1)?;
+    let ws = plan.delim == Delim::Whitespace;
+    let d = match plan.delim {
+        Delim::Byte(d) => d,
+        Delim::Whitespace => b' ',
+    };
+    for (field, slot) in plan.slots.iter().enumerate() {
+        while p < n && (b[p] == b' ' || (ws && b[p] == b'\t')) {
+            p += 1;
+        }
+        if let Some(slot) = slot {
+            let (raw, used) = parse_prefix(b.get(p..)?)?;
+            let v = (raw - slot.offset) * slot.scale;
+            if !v.is_finite() {
+                return None;
+            }
+            cols.get_mut(slot.out)?.push(v);
+            p += used;
+        } else if ws {
+            while p < n && !matches!(b[p], b' ' | b'\t' | b'\n' | b'\r' | b'#') {
+                p += 1;
+            }
+        } else {
+            while p < n && !matches!(b[p], b'\n' | b'\r' | b'#') && b[p] != d {
+                p += 1;
+            }
+        }
+        if field < last {
+            if ws {
+                if p < n && (b[p] == b' ' || b[p] == b'\t') {
+                    continue;
+                }
+                return None;
+            }
+            while p < n && b[p] == b' ' {
+                p += 1;
+            }
+            if p < n && b[p] == d {
+                p += 1;
+                continue;
+            }
+            return None;
+        }
+    }
+    while p < n && (b[p] == b' ' || b[p] == b'\t') {
+        p += 1;
+    }
+    if !ws && p < n && b[p] == d {
+        p += 1;
+        while p < n && b[p] == b' ' {
+            p += 1;
+        }
+    }
+    if p < n && b[p] == b'\r' {
+        p += 1;
+    }
+    if p >= n {
+        Some(n)
+    } else if b[p] == b'\n' {
+        Some(p + 1)
+    } else {
+        None
+    }
+}
+
+fn parse_piece(bytes: &[u8], plan: &Plan, row_guess: usize) -> Result<PieceOut, PieceErr> {
+    let mut cols: Vec<Vec<f64>> = (0..plan.nout)
+        .map(|_| Vec::with_capacity(row_guess))
+        .collect();
+    let mut rows = 0;
+    let mut line_no = 0;
+    let mut anchors = Vec::new();
+    let mut next_expected = usize::MAX;
+    let mut pos = 0;
+    while pos < bytes.len() {
+        let is_data = match fast_row(bytes, pos, plan, &mut cols) {
+            Some(next) => {
+                pos = next;
+                true
+            }
+            None => {
+                for c in &mut cols {
+                    c.truncate(rows);
+                }
+                let rest = &bytes[pos..];
+                let len = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+                let line = &rest[..len];
+                let line = line.strip_suffix(b"\r").unwrap_or(line);
+                pos += len + 1;
+                match parse_line(line, plan, &mut cols) {
+                    Ok(d) => d,
+                    Err((col, kind)) => {
+                        return Err(PieceErr {
+                            line: line_no,
+                            col,
+                            kind,
+                        });
+                    }
+                }
+            }
+        };
+        if is_data {
+            if line_no != next_expected {
+                anchors.push((rows, line_no));
+            }
+            rows += 1;
+            next_expected = line_no + 1;
+        }
+        line_no += 1;
+    }
+    Ok(PieceOut {
+        cols,
+        rows,
+        lines: line_no,
+        anchors,
+    })
+}
+
+fn detect_delimiter(line: &[u8]) -> Delim {
+    let body = match line.iter().position(|&b| b == b'#') {
+        Some(i) => &line[..i],
+        None => line,
+    };
+    if body.contains(&b';') {
+        Delim::Byte(b';')
+    } else if body.contains(&b',') {
+        Delim::Byte(b',')
+    } else if body.contains(&b'\t') {
+        let mut clean = true;
+        let _ = for_each_field(body, Delim::Byte(b'\t'), |_, _, t| {
+            clean &= !t.is_empty();
+            Ok::<(), ()>(())
+        });
+        if clean {
+            Delim::Byte(b'\t')
+        } else {
+            Delim::Whitespace
+        }
+    } else {
+        Delim::Whitespace
+    }
+}
+
+/// `name [unit]` / `name(unit)` → (name, unit).
+fn split_name_unit(raw: &str) -> (String, Option<String>) {
+    let t = raw.trim();
+    for (open, close) in [('[', ']'), ('(', ')')] {
+        if let Some(inner) = t.strip_suffix(close)
+            && let Some(i) = inner.rfind(open)
+        {
+            let name = inner[..i].trim();
+            let unit = inner[i + open.len_utf8()..].trim();
+            if !name.is_empty() {
+                return (name.to_owned(), Some(unit.to_owned()));
+            }
+        }
+    }
+    (t.to_owned(), None)
+}
+
+fn resolve(r: &ColumnRef, names: &[String], at: &Location) -> Result<usize, LogError> {
+    let unknown = || LogError::UnknownColumn {
+        at: at.clone(),
+        column: r.to_string(),
+        available: names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| format!("{}={n}", i + 1))
+            .collect::<Vec<_>>()
+            .join(", "),
+    };
+    match r {
+        ColumnRef::Index(i) => {
+            if *i >= 1 && *i <= names.len() {
+                Ok(i - 1)
+            } else {
+                Err(unknown())
+            }
+        }
+        ColumnRef::Name(n) => {
+            let exact: Vec<usize> = (0..names.len()).filter(|&i| names[i] == *n).collect();
+            let hits = if exact.is_empty() {
+                (0..names.len())
+                    .filter(|&i| names[i].eq_ignore_ascii_case(n))
+                    .collect()
+            } else {
+                exact
+            };
+            match hits.as_slice() {
+                [i] => Ok(*i),
+                [] => Err(unknown()),
+                _ => Err(LogError::InvalidOptions {
+                    at: at.clone(),
+                    message: format!(
+                        "column name {n:?} is ambiguous (fields {}); select it by number",
+                        hits.iter()
+                            .map(|i| (i + 1).to_string())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                }),
+            }
+        }
+    }
+}
+
+/// Builds the plan from the first non-comment line (`line_no` 1-based).
+fn make_plan(
+    first: &[u8],
+    line_no: usize,
+    source: &str,
+    opts: &TextOptions,
+) -> Result<Plan, LogError> {
+    let delim = match opts.delimiter {
+        Delimiter::Auto => detect_delimiter(first),
+        Delimiter::Comma => Delim::Byte(b','),
+        Delimiter::Semicolon => Delim::Byte(b';'),
+        Delimiter::Tab => Delim::Byte(b'\t'),
+        Delimiter::Whitespace => Delim::Whitespace,
+    };
+    let mut fields: Vec<String> = Vec::new();
+    let mut numeric = true;
+    let _ = for_each_field(first, delim, |_, _, t| {
+        if !t.is_empty() && parse_f64(t).is_none() {
+            numeric = false;
+        }
+        fields.push(String::from_utf8_lossy(t).into_owned());
+        Ok::<(), ()>(())
+    });
+    let has_header = match opts.header {
+        HeaderMode::Auto => !numeric,
+        HeaderMode::Present => true,
+        HeaderMode::Absent => false,
+    };
+    let nfields = fields.len();
+    let at_line = Location::line(source, line_no);
+    let at_input = Location::input(source);
+    let (mut names, hints): (Vec<String>, Vec<Option<String>>) = if has_header {
+        fields.iter().map(|f| split_name_unit(f)).unzip()
+    } else {
+        (
+            (1..=nfields).map(|i| format!("col{i}")).collect(),
+            vec![None; nfields],
+        )
+    };
+    for (i, n) in names.iter_mut().enumerate() {
+        if n.is_empty() {
+            *n = format!("col{}", i + 1);
+        }
+    }
+    if let Some(given) = &opts.column_names {
+        if given.len() != nfields {
+            return Err(LogError::InvalidOptions {
+                at: at_line,
+                message: format!(
+                    "{} column names given, but the row has {nfields} fields",
+                    given.len()
+                ),
+            });
+        }
+        names = given.clone();
+    }
+    let loc = if has_header { &at_line } else { &at_input };
+    let hint_unit = |field: usize, column: &str| -> Result<Option<Unit>, LogError> {
+        match hints.get(field).and_then(|h| h.as_deref()) {
+            None => Ok(None),
+            Some(h) => Unit::parse(h).map(Some).map_err(|_| LogError::UnknownUnit {
+                at: at_line.clone(),
+                unit: h.to_owned(),
+                column: column.to_owned(),
+                known: KNOWN_UNITS,
+            }),
+        }
+    };
+
+    let mut slots: Vec<Option<Slot>> = vec![None; nfields];
+    let mut nout = 0;
+    let time_field = match &opts.time_column {
+        None => None,
+        Some(r) => {
+            let f = resolve(r, &names, loc)?;
+            let unit = match opts.time_unit {
+                Some(u) => u,
+                None => match hints.get(f).and_then(|h| h.as_deref()) {
+                    None => TimeUnit::Seconds,
+                    Some(h) => h.parse().map_err(|_| LogError::UnknownUnit {
+                        at: at_line.clone(),
+                        unit: h.to_owned(),
+                        column: names[f].clone(),
+                        known: "s, ms, us, ns",
+                    })?,
+                },
+            };
+            slots[f] = Some(Slot {
+                out: 0,
+                scale: unit.to_s(),
+                offset: 0.0,
+            });
+            nout = 1;
+            Some(f)
+        }
+    };
+    let specs: Vec<ColumnSpec> = if opts.columns.is_empty() {
+        (1..=nfields)
+            .filter(|&i| Some(i - 1) != time_field)
+            .map(|i| ColumnSpec {
+                column: ColumnRef::Index(i),
+                unit: None,
+                rename: None,
+            })
+            .collect()
+    } else {
+        opts.columns.clone()
+    };
+    let mut channels = Vec::with_capacity(specs.len());
+    for spec in &specs {
+        let f = resolve(&spec.column, &names, loc)?;
+        if slots[f].is_some() {
+            return Err(LogError::InvalidOptions {
+                at: at_input,
+                message: format!(
+                    "column {} ({}) is selected twice (as time or data)",
+                    f + 1,
+                    names[f]
+                ),
+            });
+        }
+        let unit = match &spec.unit {
+            Some(u) => u.clone(),
+            None => match hint_unit(f, &names[f]) {
+                Ok(Some(u)) => u,
+                Ok(None) => opts.default_unit.clone().unwrap_or_default(),
+                Err(e) if opts.default_unit.is_none() => return Err(e),
+                Err(_) => opts.default_unit.clone().unwrap_or_default(),
+            },
+        };
+        slots[f] = Some(Slot {
+            out: nout,
+            scale: unit.scale_si,
+            offset: unit.offset_raw,
+        });
+        nout += 1;
+        let name = spec.rename.clone().unwrap_or_else(|| names[f].clone());
+        channels.push((f, name, unit));
+    }
+    if channels.is_empty() {
+        return Err(LogError::InvalidOptions {
+            at: at_input,
+            message: "no data columns to read (the only column is the time column)".into(),
+        });
+    }
+    Ok(Plan {
+        delim,
+        nfields,
+        reference_line: line_no,
+        names,
+        slots,
+        nout,
+        time_field,
+        channels,
+        header_line: has_header.then_some(line_no),
+    })
+}
+
+fn validate(opts: &TextOptions, source: &str) -> Result<(), LogError> {
+    let bad = |message: String| {
+        Err(LogError::InvalidOptions {
+            at: Location::input(source),
+            message,
+        })
+    };
+    if let Some(r) = opts.rate_hz
+        && !(r.is_finite() && r > 0.0)
+    {
+        return bad(format!("rate_hz must be positive and finite, got {r}"));
+    }
+    if !(opts.gap_factor.is_finite() && opts.gap_factor > 1.0) {
+        return bad(format!(
+            "gap_factor must be finite and > 1, got {}",
+            opts.gap_factor
+        ));
+    }
+    if !(opts.rate_tolerance.is_finite() && opts.rate_tolerance >= 0.0) {
+        return bad(format!(
+            "rate_tolerance must be finite and ≥ 0, got {}",
+            opts.rate_tolerance
+        ));
+    }
+    if opts.time_column.is_none() && opts.rate_hz.is_none() {
+        return bad("no time column and no rate_hz: cannot determine the sample interval τ0; give one of them".into());
+    }
+    Ok(())
+}
+
+/// Row → 1-based line lookup from sparse anchors.
+struct LineMap {
+    anchors: Vec<(usize, usize)>,
+}
+
+impl LineMap {
+    fn line_of(&self, row: usize) -> usize {
+        let i = self.anchors.partition_point(|a| a.0 <= row);
+        match i.checked_sub(1).and_then(|i| self.anchors.get(i)) {
+            Some(&(r, l)) => l + (row - r),
+            None => row + 1,
+        }
+    }
+}
+
+fn read_impl<R: Read>(
+    mut reader: R,
+    source: &str,
+    opts: &TextOptions,
+    size_hint: Option<u64>,
+) -> Result<ImuLog, LogError> {
+    validate(opts, source)?;
+    let io = |error| LogError::Io {
+        path: source.to_owned(),
+        error,
+    };
+    let threads = rayon::current_num_threads().max(1);
+    let mut buf = vec![0u8; opts.chunk_bytes.max(64)];
+    let mut filled = 0;
+    let mut eof = false;
+    let mut plan: Option<Plan> = None;
+    let mut line_base = 1usize; // 1-based line number of buf[0]
+    let mut out: Vec<Vec<f64>> = Vec::new();
+    let mut rows_total = 0usize;
+    let mut anchors: Vec<(usize, usize)> = Vec::new();
+    let mut bytes_per_row: Option<f64> = None;
+    loop {
+        while filled < buf.len() && !eof {
+            match reader.read(&mut buf[filled..]) {
+                Ok(0) => eof = true,
+                Ok(n) => filled += n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(io(e)),
+            }
+        }
+        let end = if eof {
+            filled
+        } else {
+            match buf[..filled].iter().rposition(|&b| b == b'\n') {
+                Some(i) => i + 1,
+                None => {
+                    // One line longer than the buffer: grow and read on.
+                    let n = buf.len();
+                    buf.resize(n.saturating_mul(2), 0);
+                    continue;
+                }
+            }
+        };
+        let region = &buf[..end];
+        let mut start = 0;
+        if plan.is_none() {
+            let mut offset = 0;
+            for (i, line) in lines(region).enumerate() {
+                let this_len = line_len_with_end(region, offset);
+                if !is_blank_or_comment(line) {
+                    let p = make_plan(line, line_base + i, source, opts)?;
+                    if p.header_line.is_some() {
+                        start = offset + this_len;
+                        line_base += i + 1;
+                    } else {
+                        start = offset;
+                        line_base += i;
+                    }
+                    plan = Some(p);
+                    break;
+                }
+                offset += this_len;
+            }
+            if plan.is_none() {
+                line_base += lines(region).count();
+                start = end;
+            }
+        }
+        if let Some(p) = &plan
+            && start < end
+        {
+            let data = &region[start..end];
+            let pieces = split_pieces(data, if data.len() >= (1 << 20) { threads } else { 1 });
+            let row_guess = bytes_per_row
+                .map(|b| ((data.len() as f64 / pieces.len() as f64) / b * 1.05) as usize + 16)
+                .unwrap_or(0);
+            let results: Vec<Result<PieceOut, PieceErr>> = if pieces.len() > 1 {
+                pieces
+                    .par_iter()
+                    .map(|s| parse_piece(s, p, row_guess))
+                    .collect()
+            } else {
+                pieces
+                    .iter()
+                    .map(|s| parse_piece(s, p, row_guess))
+                    .collect()
+            };
+            let region_rows: usize = results
+                .iter()
+                .map(|r| r.as_ref().map_or(0, |o| o.rows))
+                .sum();
+            if out.is_empty() {
+                out = (0..p.nout).map(|_| Vec::new()).collect();
+                if region_rows > 0 {
+                    let bpr = data.len() as f64 / region_rows as f64;
+                    bytes_per_row = Some(bpr);
+                    let est = match size_hint {
+                        Some(size) => (size as f64 / bpr * 1.02) as usize + 1024,
+                        None => region_rows,
+                    };
+                    for c in &mut out {
+                        c.reserve_exact(est);
+                    }
+                }
+            }
+            for r in results {
+                match r {
+                    Ok(piece) => {
+                        for (o, c) in out.iter_mut().zip(&piece.cols) {
+                            if o.capacity() - o.len() < c.len() {
+                                // Estimate too low: grow by at least 1/8 rather than doubling.
+                                o.reserve_exact(c.len().max(o.capacity() / 8));
+                            }
+                            o.extend_from_slice(c);
+                        }
+                        for &(r, l) in &piece.anchors {
+                            let (row, line) = (rows_total + r, line_base + l);
+                            let predicted = anchors.last().map(|&(ar, al)| al + (row - ar));
+                            if predicted != Some(line) {
+                                anchors.push((row, line));
+                            }
+                        }
+                        rows_total += piece.rows;
+                        line_base += piece.lines;
+                    }
+                    Err(e) => return Err(piece_error(e, line_base, p, source)),
+                }
+            }
+        }
+        if eof {
+            break;
+        }
+        buf.copy_within(end..filled, 0);
+        filled -= end;
+    }
+    let Some(plan) = plan else {
+        return Err(LogError::Empty {
+            at: Location::input(source),
+        });
+    };
+    if rows_total == 0 {
+        return Err(match plan.header_line {
+            Some(l) => LogError::HeaderOnly {
+                at: Location::line(source, l),
+            },
+            None => LogError::Empty {
+                at: Location::input(source),
+            },
+        });
+    }
+    for c in &mut out {
+        c.shrink_to_fit();
+    }
+    let map = LineMap { anchors };
+    let mut cols = out.into_iter();
+    let time_s = if plan.time_field.is_some() {
+        cols.next()
+    } else {
+        None
+    };
+    let (tau0_s, segments, gaps) = match (&time_s, plan.time_field) {
+        (Some(t), Some(tf)) => time_analysis(t, tf, &plan, &map, source, opts)?,
+        _ => {
+            let rate = opts.rate_hz.unwrap_or(f64::NAN);
+            (
+                1.0 / rate,
+                std::iter::once(0..rows_total).collect(),
+                Vec::new(),
+            )
+        }
+    };
+    let channels = plan
+        .channels
+        .iter()
+        .zip(cols)
+        .map(|((_, name, unit), values)| Channel {
+            name: name.clone(),
+            quantity: unit.quantity,
+            source_unit: unit.label.clone(),
+            values,
+        })
+        .collect();
+    Ok(ImuLog {
+        source: source.to_owned(),
+        time_s,
+        tau0_s,
+        channels,
+        segments,
+        gaps,
+    })
+}
+
+/// Length of the line starting at `offset` including its `\n`.
+fn line_len_with_end(region: &[u8], offset: usize) -> usize {
+    let rest = region.get(offset..).unwrap_or(&[]);
+    match rest.iter().position(|&b| b == b'\n') {
+        Some(i) => i + 1,
+        None => rest.len(),
+    }
+}
+
+/// Splits `data` into about `k` pieces at line ends.
+fn split_pieces(data: &[u8], k: usize) -> Vec<&[u8]> {
+    let mut pieces = Vec::with_capacity(k);
+    let mut start = 0;
+    for j in 1..k {
+        let target = (data.len() * j / k).max(start);
+        let cut = match data
+            .get(target..)
+            .and_then(|r| r.iter().position(|&b| b == b'\n'))
+        {
+            Some(i) => target + i + 1,
+            None => data.len(),
+        };
+        if cut > start {
+            pieces.push(&data[start..cut]);
+            start = cut;
+        }
+    }
+    if start < data.len() || pieces.is_empty() {
+        pieces.push(&data[start..]);
+    }
+    pieces
+}
+
+fn piece_error(e: PieceErr, line_base: usize, plan: &Plan, source: &str) -> LogError {
+    let at = Location::field(source, line_base + e.line, e.col);
+    let name = |field: usize| plan.names.get(field - 1).cloned().unwrap_or_default();
+    match e.kind {
+        FieldErr::NonNumeric { field, value } => LogError::NonNumeric {
+            at,
+            value,
+            field,
+            name: name(field),
+        },
+        FieldErr::Empty { field } => LogError::EmptyField {
+            at,
+            field,
+            name: name(field),
+        },
+        FieldErr::NonFinite { field, value } => LogError::NonFinite {
+            at,
+            value,
+            field,
+            name: name(field),
+        },
+        FieldErr::Ragged { found } => LogError::Ragged {
+            at,
+            found,
+            expected: plan.nfields,
+            reference_line: plan.reference_line,
+        },
+    }
+}
+
+type TimeResult = (f64, Vec<Range<usize>>, Vec<TimeGap>);
+
+fn time_analysis(
+    t: &[f64],
+    tf: usize,
+    plan: &Plan,
+    map: &LineMap,
+    source: &str,
+    opts: &TextOptions,
+) -> Result<TimeResult, LogError> {
+    let name = plan.names.get(tf).cloned().unwrap_or_default();
+    let field = tf + 1;
+    for i in 1..t.len() {
+        let (a, b) = (t[i - 1], t[i]);
+        if b < a {
+            return Err(LogError::NonMonotonicTime {
+                at: Location::line(source, map.line_of(i)),
+                field,
+                name,
+                time_s: b,
+                previous_s: a,
+            });
+        }
+        if b == a {
+            return Err(LogError::DuplicateTime {
+                at: Location::line(source, map.line_of(i)),
+                field,
+                name,
+                time_s: b,
+            });
+        }
+    }
+    let tau0_s = if t.len() >= 2 {
+        let mut dt: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+        let mid = dt.len() / 2;
+        let (_, m, _) = dt.select_nth_unstable_by(mid, f64::total_cmp);
+        let mut median = *m;
+        if dt.len().is_multiple_of(2) {
+            // even count: mean of the two middle values; the lower one is the max of the left half
+            let lower = dt[..mid].iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            median = 0.5 * (median + lower);
+        }
+        if let Some(rate) = opts.rate_hz {
+            let nominal = 1.0 / rate;
+            if ((median - nominal) / nominal).abs() > opts.rate_tolerance {
+                return Err(LogError::RateMismatch {
+                    at: Location::input(source),
+                    rate_hz: rate,
+                    median_dt_s: median,
+                    measured_hz: 1.0 / median,
+                    tolerance_pct: opts.rate_tolerance * 100.0,
+                });
+            }
+        }
+        median
+    } else {
+        match opts.rate_hz {
+            Some(r) => 1.0 / r,
+            None => {
+                return Err(LogError::InvalidOptions {
+                    at: Location::input(source),
+                    message: "a single time stamp cannot give the sample interval τ0; give rate_hz"
+                        .into(),
+                });
+            }
+        }
+    };
+    let limit = opts.gap_factor * tau0_s;
+    let mut gaps = Vec::new();
+    for i in 1..t.len() {
+        let d = t[i] - t[i - 1];
+        if d > limit {
+            if opts.gap_policy == GapPolicy::Error {
+                return Err(LogError::TimeGap {
+                    at: Location::line(source, map.line_of(i)),
+                    field,
+                    name,
+                    duration_s: d,
+                    ratio: d / tau0_s,
+                    tau0_s,
+                    gap_factor: opts.gap_factor,
+                });
+            }
+            gaps.push(TimeGap {
+                index: i,
+                start_s: t[i - 1],
+                duration_s: d,
+            });
+        }
+    }
+    let segments = match opts.gap_policy {
+        GapPolicy::Split => {
+            let mut s = Vec::with_capacity(gaps.len() + 1);
+            let mut start = 0;
+            for g in &gaps {
+                s.push(start..g.index);
+                start = g.index;
+            }
+            s.push(start..t.len());
+            s
+        }
+        _ => std::iter::once(0..t.len()).collect(),
+    };
+    Ok((tau0_s, segments, gaps))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pieces_cover_data_at_line_ends() {
+        let data = b"1\n22\n333\n4444\n55555\n";
+        for k in 1..8 {
+            let p = split_pieces(data, k);
+            assert_eq!(p.concat(), data.to_vec());
+            for piece in &p {
+                assert_eq!(piece.last(), Some(&b'\n'));
+            }
+        }
+    }
+
+    #[test]
+    fn header_units_in_brackets() {
+        assert_eq!(
+            split_name_unit("gyro_x [deg/s]"),
+            ("gyro_x".into(), Some("deg/s".into()))
+        );
+        assert_eq!(
+            split_name_unit("tick(ms)"),
+            ("tick".into(), Some("ms".into()))
+        );
+        assert_eq!(split_name_unit("acc_z"), ("acc_z".into(), None));
+    }
+
+    #[test]
+    fn delimiter_detection() {
+        assert_eq!(detect_delimiter(b"1,2,3"), Delim::Byte(b','));
+        assert_eq!(detect_delimiter(b"1;2,5;3"), Delim::Byte(b';'));
+        assert_eq!(detect_delimiter(b"a\tb c\td"), Delim::Byte(b'\t'));
+        assert_eq!(detect_delimiter(b"  1\t\t2 3"), Delim::Whitespace);
+        assert_eq!(detect_delimiter(b"1 2 3 # a, b"), Delim::Whitespace);
+    }
+
+    #[test]
+    fn line_map_follows_anchors() {
+        let m = LineMap {
+            anchors: vec![(0, 3), (5, 10)],
+        };
+        assert_eq!(m.line_of(0), 3);
+        assert_eq!(m.line_of(4), 7);
+        assert_eq!(m.line_of(5), 10);
+        assert_eq!(m.line_of(9), 14);
+    }
+}
