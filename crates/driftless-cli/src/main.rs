@@ -1,2 +1,55 @@
-//! `driftless` command-line tool.
-fn main() {}
+//! `driftless` — from raw MEMS IMU logs to a navigation error budget.
+//!
+//! Subcommands: `allan` (noise analysis), `convert` (text ↔ compact binary log),
+//! `demo` (the whole issue-2 pipeline on built-in simulated data).
+
+mod allan_cmd;
+mod bench_cmd;
+mod convert_cmd;
+mod demo_cmd;
+mod input;
+mod output;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "driftless",
+    version,
+    about = "MEMS IMU noise analysis, calibration and GNSS/INS error budgets",
+    propagate_version = true
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Allan-family deviations, confidence intervals and IMU noise terms of a log.
+    Allan(allan_cmd::AllanArgs),
+    /// Convert a delimited text log to the compact binary log format (or back).
+    Convert(convert_cmd::ConvertArgs),
+    /// Speed benchmarks (parse, binary read, exact and fast OADEV) on generated data.
+    Bench(bench_cmd::BenchArgs),
+    /// Simulate an 18-h static six-axis IMU log with known noise, analyse it, compare.
+    Demo(demo_cmd::DemoArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Allan(a) => allan_cmd::run(a),
+        Command::Convert(a) => convert_cmd::run(a),
+        Command::Demo(a) => demo_cmd::run(a),
+        Command::Bench(a) => bench_cmd::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -6,7 +6,8 @@
 //!
 //! Conventions: SI inside (s, m, rad, m/s, m/s², rad/s, °C). Display/file units
 //! (deg/h, deg/√h, mg, g …) are converted at the edges only.
-#![forbid(unsafe_code)]
+// One audited exception: the AVX2 dispatch of the Allan kernel (allan::estimators).
+#![deny(unsafe_code)]
 
 pub mod allan;
 pub mod io;

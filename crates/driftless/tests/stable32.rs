@@ -90,7 +90,10 @@ fn check_file(case: &Case, result_file: &str, tau0: f64) -> (usize, f64, f64) {
     let exempt_ci = case.folder == "ocxo" && est == Estimator::Totdev;
     let (mut worst_dev, mut worst_ci) = (0.0f64, 0.0f64);
     for r in &rows {
-        assert!((r.tau - r.m as f64 * tau0).abs() <= 1e-4 * r.tau, "{result_file}: tau0");
+        assert!(
+            (r.tau - r.m as f64 * tau0).abs() <= 1e-4 * r.tau,
+            "{result_file}: tau0"
+        );
         let cfg = AnalysisConfig {
             estimator: est,
             taus: TauSpec::List(vec![r.m as f64 * tau0]),

@@ -113,7 +113,11 @@ pub fn analyse_segments(
         ));
     }
     if let Some(a) = cfg.alpha {
-        let range = if cfg.estimator.is_hadamard() { -4..=2 } else { -2..=2 };
+        let range = if cfg.estimator.is_hadamard() {
+            -4..=2
+        } else {
+            -2..=2
+        };
         if !range.contains(&a) {
             return Err(AllanError::Invalid(format!(
                 "alpha {a} is outside {}..={} for {}",
@@ -167,18 +171,24 @@ pub fn analyse_segments(
     let mut dev_hi = Vec::with_capacity(ms.len());
     let mut alphas = Vec::with_capacity(ms.len());
     let mut edfs = Vec::with_capacity(ms.len());
+    let total: Vec<Sums> = total.into_iter().filter(|s| s.n > 0).collect();
+    // Noise identification per tau is independent: run it on all cores.
+    let identified: Vec<Result<i32, AllanError>> = total
+        .par_iter()
+        .map(|s| match cfg.alpha {
+            Some(a) => Ok(a),
+            None => ci::identify_alpha(longest, s.m, cfg.estimator),
+        })
+        .collect();
     let mut last_alpha: Option<i32> = None;
-    for s in total.into_iter().filter(|s| s.n > 0) {
+    for (s, id) in total.into_iter().zip(identified) {
         let dev = estimators::finish(cfg.estimator, s, tau0_s);
-        let alpha = match cfg.alpha {
-            Some(a) => a,
-            None => match ci::identify_alpha(longest, s.m, cfg.estimator) {
-                Ok(a) => a,
-                // Too few points left at this tau to identify: keep the last identified type.
-                Err(e) => match last_alpha {
-                    Some(a) => a,
-                    None => return Err(e),
-                },
+        let alpha = match id {
+            Ok(a) => a,
+            // Too few points left at this tau to identify: keep the last identified type.
+            Err(e) => match last_alpha {
+                Some(a) => a,
+                None => return Err(e),
             },
         };
         last_alpha = Some(alpha);

@@ -1,3 +1,784 @@
-//! Noise-model file (TOML) written by `driftless allan` and read by the filter and simulator.
+//! Noise-model file (TOML) written by `driftless allan --save-model` and read by the
+//! filter-tuning and simulation commands.
 //!
-//! OWNER: helper "fit".
+//! Each channel stores the fitted IEEE Std 952-1997 terms **in SI** (the authoritative
+//! values, with confidence intervals), plus two derived views that are written for humans
+//! and for filter code and ignored when the model is used programmatically:
+//!
+//! * **display** — the same continuous-time terms in the customary datasheet units
+//!   (gyro: deg, deg/√h, deg/h, deg/h/√h, deg/h²; accel: m/s, m/s/√h, mg/µg, m/s²/√s …);
+//! * **discrete** — what a discrete-time filter or simulator running at the sample rate
+//!   f_s = 1/Δt needs per sample. Continuous and discrete are easy to confuse:
+//!
+//! | term | continuous (SI) | discrete, per sample at f_s |
+//! |------|-----------------|-----------------------------|
+//! | white N | density N [u·√s], two-sided PSD N² [u²/Hz] | σ_d = N·√f_s [u] (std of each rate sample) |
+//! | rate random walk K | density K [u/√s], PSD of the bias derivative K² [u²/s] | σ_Δb = K·√Δt [u] (std of the bias change per step) |
+//! | bias instability B | flicker floor, ADEV ≈ 0.664·B | no exact finite-state form; a first-order Gauss-Markov (σ_b, T_c) whose Allan-variance peak equals the floor at the floor's τ: φ = e^{−Δt/T_c}, σ_w = σ_b·√(1−φ²) |
+//! | quantization Q | angle/velocity noise [u·s] | std Q of each integrated (angle/velocity) sample |
+//! | rate ramp R | [u/s] | R·Δt per sample (deterministic) |
+//!
+//! Sources: IEEE Std 952-1997 Annex C; IEEE Std 1293-2018; El-Sheimy, Hou & Niu 2008;
+//! discrete Gauss-Markov: Gelb, *Applied Optimal Estimation* (1974) §4.4.
+
+use std::path::{Path, PathBuf};
+
+use driftless_model::units::{
+    DEG, DEG_PER_H, DEG_PER_H_PER_SQRT_H, DEG_PER_SQRT_H, HOUR_S, M_PER_S_PER_SQRT_H, MICRO_G,
+    MILLI_G,
+};
+use serde::{Deserialize, Serialize};
+
+use super::AllanError;
+use super::analysis::ChannelResult;
+use super::fit::{
+    BIAS_AVAR_COEF, FitConfig, NoiseFit, SlopeReadings, Term, TermKind, fit_noise_with_edf,
+    gauss_markov_avar_peak, slope_readings,
+};
+
+const ALL_TERMS: [TermKind; 6] = [
+    TermKind::Quantization,
+    TermKind::White,
+    TermKind::BiasInstability,
+    TermKind::RateRandomWalk,
+    TermKind::RateRamp,
+    TermKind::GaussMarkov,
+];
+
+fn term_label(k: TermKind) -> &'static str {
+    match k {
+        TermKind::Quantization => "quantization Q",
+        TermKind::White => "white N",
+        TermKind::BiasInstability => "bias instab. B",
+        TermKind::RateRandomWalk => "rate rand. walk K",
+        TermKind::RateRamp => "rate ramp R",
+        TermKind::GaussMarkov => "GM sigma",
+    }
+}
+
+/// SI unit of each term for rate samples in `unit` (u·s, u·√s, u, u/√s, u/s).
+fn si_term_units(unit: &str) -> impl Fn(TermKind) -> String + '_ {
+    let u = if unit.is_empty() { "u" } else { unit };
+    move |k| match k {
+        TermKind::Quantization => format!("({u})·s"),
+        TermKind::White => format!("({u})·sqrt(s)"),
+        TermKind::BiasInstability | TermKind::GaussMarkov => u.to_string(),
+        TermKind::RateRandomWalk => format!("({u})/sqrt(s)"),
+        TermKind::RateRamp => format!("({u})/s"),
+    }
+}
+
+fn fmt_num(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if !v.is_finite() {
+        format!("{v}")
+    } else if (1e-3..1e5).contains(&v.abs()) {
+        // five significant digits
+        let d = (4 - v.abs().log10().floor() as i32).clamp(0, 7) as usize;
+        format!("{v:.d$}")
+    } else {
+        format!("{v:.4e}")
+    }
+}
+
+/// Current file format version.
+pub const FORMAT_VERSION: u32 = 1;
+
+pub use crate::io::Quantity;
+
+/// Display units of a term for a channel quantity: (unit name, size of one display unit
+/// in SI). Angular rate → gyro units, specific force → accelerometer units; other
+/// quantities have none (their terms stay in SI).
+pub fn display_units(quantity: Quantity, term: TermKind) -> &'static [(&'static str, f64)] {
+    GyroOrAccel::of(quantity).map_or(&[], |g| g.display_units(term))
+}
+
+#[derive(Clone, Copy)]
+enum GyroOrAccel {
+    Gyro,
+    Accel,
+}
+
+impl GyroOrAccel {
+    fn of(q: Quantity) -> Option<GyroOrAccel> {
+        match q {
+            Quantity::AngularRate => Some(GyroOrAccel::Gyro),
+            Quantity::SpecificForce => Some(GyroOrAccel::Accel),
+            Quantity::Temperature | Quantity::Other => None,
+        }
+    }
+
+    /// Display units of a term: (unit name, size of one display unit in SI).
+    fn display_units(self, term: TermKind) -> &'static [(&'static str, f64)] {
+        const DEG_PER_H2: f64 = DEG / (HOUR_S * HOUR_S);
+        const M_PER_S_PER_H15: f64 = 1.0 / (HOUR_S * 60.0);
+        match (self, term) {
+            (GyroOrAccel::Gyro, TermKind::Quantization) => &[("deg", DEG), ("urad", 1e-6)],
+            (GyroOrAccel::Gyro, TermKind::White) => {
+                &[("deg/sqrt(h)", DEG_PER_SQRT_H), ("deg/s/sqrt(Hz)", DEG)]
+            }
+            (GyroOrAccel::Gyro, TermKind::BiasInstability | TermKind::GaussMarkov) => {
+                &[("deg/h", DEG_PER_H)]
+            }
+            (GyroOrAccel::Gyro, TermKind::RateRandomWalk) => {
+                &[("deg/h/sqrt(h)", DEG_PER_H_PER_SQRT_H)]
+            }
+            (GyroOrAccel::Gyro, TermKind::RateRamp) => &[("deg/h^2", DEG_PER_H2)],
+            (GyroOrAccel::Accel, TermKind::Quantization) => &[("m/s", 1.0)],
+            (GyroOrAccel::Accel, TermKind::White) => &[
+                ("m/s/sqrt(h)", M_PER_S_PER_SQRT_H),
+                ("ug/sqrt(Hz)", MICRO_G),
+            ],
+            (GyroOrAccel::Accel, TermKind::BiasInstability | TermKind::GaussMarkov) => {
+                &[("ug", MICRO_G), ("mg", MILLI_G)]
+            }
+            (GyroOrAccel::Accel, TermKind::RateRandomWalk) => {
+                &[("m/s^2/sqrt(s)", 1.0), ("m/s/h^1.5", M_PER_S_PER_H15)]
+            }
+            (GyroOrAccel::Accel, TermKind::RateRamp) => &[("m/s^3", 1.0)],
+        }
+    }
+}
+
+/// One term in a display unit. A term that was fitted but not detected has
+/// `detected = false`, value = lo = 0 and `hi` = its upper limit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DisplayValue {
+    /// Which term.
+    pub term: TermKind,
+    /// Display unit.
+    pub unit: String,
+    /// Estimate.
+    pub value: f64,
+    /// Lower confidence bound.
+    pub lo: f64,
+    /// Upper confidence bound (upper limit when not detected).
+    pub hi: f64,
+    /// Whether the term was detected.
+    pub detected: bool,
+}
+
+/// Continuous-time terms of a fit in display units (every unit of
+/// [`display_units`]), detected terms first in model order, then upper limits.
+pub fn display_terms(fit: &NoiseFit, quantity: Quantity) -> Vec<DisplayValue> {
+    let mut out = Vec::new();
+    for kind in [
+        TermKind::Quantization,
+        TermKind::White,
+        TermKind::BiasInstability,
+        TermKind::RateRandomWalk,
+        TermKind::RateRamp,
+        TermKind::GaussMarkov,
+    ] {
+        let (t, detected) = match fit.term(kind) {
+            Some(t) => (t, true),
+            None => match fit.not_detected.iter().find(|u| u.term == kind) {
+                Some(u) => (
+                    Term {
+                        value: 0.0,
+                        lo: 0.0,
+                        hi: u.upper,
+                    },
+                    false,
+                ),
+                None => continue,
+            },
+        };
+        for &(unit, size) in display_units(quantity, kind) {
+            out.push(DisplayValue {
+                term: kind,
+                unit: unit.to_string(),
+                value: t.value / size,
+                lo: t.lo / size,
+                hi: t.hi / size,
+                detected,
+            });
+        }
+    }
+    out
+}
+
+/// Discrete first-order Gauss-Markov process b_{k+1} = φ b_k + w_k.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DiscreteGaussMarkov {
+    /// Stationary σ_b, u.
+    pub sigma: f64,
+    /// Correlation time T_c, s.
+    pub tau_c_s: f64,
+    /// φ = e^{−Δt/T_c}.
+    pub phi: f64,
+    /// Std of the per-sample driving noise w_k, σ_b·√(1 − φ²), u.
+    pub sigma_w: f64,
+    /// Continuous driving-noise PSD q_c = 2σ_b²/T_c, u²/s.
+    pub q_c: f64,
+}
+
+impl DiscreteGaussMarkov {
+    /// Discretise (σ, T_c) at sample interval `dt`.
+    pub fn new(sigma: f64, tau_c_s: f64, dt: f64) -> DiscreteGaussMarkov {
+        let phi = (-dt / tau_c_s).exp();
+        DiscreteGaussMarkov {
+            sigma,
+            tau_c_s,
+            phi,
+            sigma_w: sigma * (1.0 - phi * phi).max(0.0).sqrt(),
+            q_c: 2.0 * sigma * sigma / tau_c_s,
+        }
+    }
+}
+
+/// Per-sample (discrete-time) noise parameters at the model's sample rate, SI units
+/// (u = rad/s or m/s²). `None` = term absent. See the module table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DiscreteNoise {
+    /// Sample rate the discrete values refer to, Hz.
+    pub sample_rate_hz: f64,
+    /// Std of the white noise on each rate sample, σ_d = N·√f_s, u.
+    pub white_sigma: Option<f64>,
+    /// Continuous white-noise PSD N² (two-sided), u²/Hz — for continuous-time filters.
+    pub white_psd: Option<f64>,
+    /// Std of the bias random-walk step per sample, K·√Δt, u.
+    pub rate_random_walk_sigma: Option<f64>,
+    /// Continuous PSD of the bias derivative K², u²/s.
+    pub rate_random_walk_psd: Option<f64>,
+    /// Std of the quantization noise of each integrated sample (angle/velocity), Q, u·s.
+    pub quantization_sigma: Option<f64>,
+    /// Bias change per sample from the rate ramp, R·Δt, u.
+    pub rate_ramp_per_sample: Option<f64>,
+    /// First-order Gauss-Markov stand-in for the bias instability: Allan-variance peak
+    /// (0.3811 σ_b² at τ = 1.893 T_c) equal to the floor (2 ln2/π)B² at the τ where the
+    /// fitted curve is lowest. An approximation: one GM reproduces the floor only near
+    /// that τ.
+    pub bias_instability_gm: Option<DiscreteGaussMarkov>,
+    /// The fitted Gauss-Markov term, discretised.
+    pub gauss_markov: Option<DiscreteGaussMarkov>,
+}
+
+/// Discrete per-sample parameters of a fit at sample rate `fs` (Hz).
+pub fn discrete_noise(fit: &NoiseFit, fs: f64) -> DiscreteNoise {
+    let dt = 1.0 / fs;
+    let v = |t: Option<Term>| t.map(|t| t.value);
+    let bias_instability_gm = v(fit.bias_instability).map(|b| {
+        let (u_peak, peak) = gauss_markov_avar_peak();
+        let tau_floor = model_minimum_tau(fit);
+        let sigma = (BIAS_AVAR_COEF * b * b / peak).sqrt();
+        DiscreteGaussMarkov::new(sigma, tau_floor / u_peak, dt)
+    });
+    DiscreteNoise {
+        sample_rate_hz: fs,
+        white_sigma: v(fit.white).map(|n| n * fs.sqrt()),
+        white_psd: v(fit.white).map(|n| n * n),
+        rate_random_walk_sigma: v(fit.rate_random_walk).map(|k| k * dt.sqrt()),
+        rate_random_walk_psd: v(fit.rate_random_walk).map(|k| k * k),
+        quantization_sigma: v(fit.quantization),
+        rate_ramp_per_sample: v(fit.rate_ramp).map(|r| r * dt),
+        bias_instability_gm,
+        gauss_markov: fit
+            .gauss_markov
+            .map(|g| DiscreteGaussMarkov::new(g.sigma.value, g.tau_c_s.value, dt)),
+    }
+}
+
+/// τ (s) minimising the fitted Allan variance over 1e-4 … 1e7 s (log-spaced scan then
+/// golden refinement). With only white + bias + RRW this is √3·N/K.
+pub fn model_minimum_tau(fit: &NoiseFit) -> f64 {
+    let f = |lt: f64| fit.model_avar(lt.exp());
+    let (lo, hi) = (1e-4f64.ln(), 1e7f64.ln());
+    let n = 221;
+    let mut best = (lo, f64::INFINITY);
+    for i in 0..n {
+        let x = lo + (hi - lo) * i as f64 / (n - 1) as f64;
+        let v = f(x);
+        if v < best.1 {
+            best = (x, v);
+        }
+    }
+    let step = (hi - lo) / (n - 1) as f64;
+    let (x, _) = super::fit::golden_max(|x| -f(x), best.0 - step, best.0 + step);
+    x.exp()
+}
+
+/// One channel of a noise model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ChannelNoise {
+    /// Channel name (e.g. `gyro_x`).
+    pub name: String,
+    /// Gyro or accelerometer.
+    pub quantity: Quantity,
+    /// SI unit of the rate samples (`rad/s`, `m/s^2`).
+    pub unit: String,
+    /// Fitted continuous-time terms, SI, with confidence intervals (authoritative).
+    pub fit: NoiseFit,
+    /// Classic slope readings, if computed.
+    #[serde(default)]
+    pub slope_readings: Option<SlopeReadings>,
+    /// Same terms in display units (informational; recomputed by [`ChannelNoise::new`]).
+    #[serde(default)]
+    pub display: Vec<DisplayValue>,
+    /// Per-sample discrete parameters at the model's sample rate (informational).
+    pub discrete: DiscreteNoise,
+}
+
+impl ChannelNoise {
+    /// Build a channel, deriving the display and discrete views from `fit`.
+    pub fn new(name: &str, quantity: Quantity, fit: NoiseFit, sample_rate_hz: f64) -> Self {
+        ChannelNoise {
+            name: name.to_string(),
+            quantity,
+            unit: quantity.si_unit().to_string(),
+            display: display_terms(&fit, quantity),
+            discrete: discrete_noise(&fit, sample_rate_hz),
+            fit,
+            slope_readings: None,
+        }
+    }
+}
+
+/// A noise-model file: one entry per analysed channel.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NoiseModel {
+    /// File format version ([`FORMAT_VERSION`]).
+    pub format_version: u32,
+    /// Log the model was fitted from.
+    #[serde(default)]
+    pub source_file: Option<String>,
+    /// Sample rate of that log, Hz.
+    pub sample_rate_hz: f64,
+    /// Estimator the curve came from (`oadev`, …).
+    #[serde(default)]
+    pub estimator: Option<String>,
+    /// Channels.
+    pub channels: Vec<ChannelNoise>,
+}
+
+/// Errors reading or writing a noise-model file.
+#[derive(Debug, thiserror::Error)]
+pub enum NoiseModelError {
+    /// The file could not be read.
+    #[error("cannot read noise model {path}: {source}")]
+    Read {
+        /// File.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// The file could not be written.
+    #[error("cannot write noise model {path}: {source}")]
+    Write {
+        /// File.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// Not a valid noise-model TOML document.
+    #[error("noise model {path}: {source}")]
+    Parse {
+        /// File (`<string>` when parsed from memory).
+        path: PathBuf,
+        /// Cause, with line and column.
+        source: Box<toml::de::Error>,
+    },
+    /// Serialisation failed (a value TOML cannot hold).
+    #[error("cannot serialise noise model: {0}")]
+    Serialize(#[from] toml::ser::Error),
+    /// Parsed, but the contents are unusable.
+    #[error("noise model {path}: {why}")]
+    Invalid {
+        /// File (`<string>` when parsed from memory).
+        path: PathBuf,
+        /// What is wrong.
+        why: String,
+    },
+}
+
+impl NoiseModel {
+    /// New empty model.
+    pub fn new(
+        source_file: Option<String>,
+        sample_rate_hz: f64,
+        estimator: Option<String>,
+    ) -> Self {
+        NoiseModel {
+            format_version: FORMAT_VERSION,
+            source_file,
+            sample_rate_hz,
+            estimator,
+            channels: Vec::new(),
+        }
+    }
+
+    /// Channel by name.
+    pub fn channel(&self, name: &str) -> Option<&ChannelNoise> {
+        self.channels.iter().find(|c| c.name == name)
+    }
+
+    /// The fits, in channel order.
+    pub fn fits(&self) -> impl Iterator<Item = &NoiseFit> {
+        self.channels.iter().map(|c| &c.fit)
+    }
+
+    /// Fit every channel's Allan curve (an OADEV-family [`ChannelResult`]) and collect the
+    /// model. The EDF of each point follows the dominant term's noise exponent
+    /// ([`fit_noise_with_edf`] with [`ChannelResult::edf_for_alpha`]); the classic slope
+    /// readings are stored alongside. `quantities[i]` belongs to `curves[i]`.
+    pub fn from_curves(
+        source: &str,
+        curves: &[ChannelResult],
+        quantities: &[Quantity],
+        cfg: &FitConfig,
+        confidence: f64,
+    ) -> Result<NoiseModel, AllanError> {
+        if curves.len() != quantities.len() {
+            return Err(AllanError::Invalid(format!(
+                "noise model: {} curves but {} quantities",
+                curves.len(),
+                quantities.len()
+            )));
+        }
+        let fs = curves.first().map_or(0.0, |c| 1.0 / c.tau0_s);
+        let estimator = curves.first().map(|c| c.estimator.name().to_string());
+        let mut model = NoiseModel::new(Some(source.to_string()), fs, estimator);
+        for (c, &q) in curves.iter().zip(quantities) {
+            let tau: Vec<f64> = c.points.iter().map(|p| p.tau).collect();
+            let avar: Vec<f64> = c.points.iter().map(|p| p.dev * p.dev).collect();
+            let adev: Vec<f64> = c.points.iter().map(|p| p.dev).collect();
+            let fit =
+                fit_noise_with_edf(&tau, &avar, |i, a| c.edf_for_alpha(i, a), cfg, confidence)
+                    .map_err(|e| {
+                        AllanError::Invalid(format!("noise fit of channel '{}': {e}", c.name))
+                    })?;
+            let mut ch = ChannelNoise::new(&c.name, q, fit, 1.0 / c.tau0_s);
+            ch.slope_readings = Some(slope_readings(&tau, &adev));
+            model.channels.push(ch);
+        }
+        Ok(model)
+    }
+
+    /// Human-readable summary: per channel the continuous terms in display units with
+    /// their intervals, upper limits of undetected terms, and the per-sample discrete σ.
+    pub fn human_table(&self) -> String {
+        let mut s = String::new();
+        let conf = self
+            .channels
+            .first()
+            .map_or(0.0, |c| 100.0 * c.fit.confidence);
+        s.push_str(&format!(
+            "Noise terms (IEEE 952 fit, {conf:.1} % intervals). Continuous-time densities first; \
+             'discrete' lines are per-sample values at {} Hz.\n",
+            fmt_num(self.sample_rate_hz)
+        ));
+        for c in &self.channels {
+            s.push_str(&format!(
+                "\n{} [{}]  (rms log10 residual {:.3})\n",
+                c.name,
+                if c.unit.is_empty() {
+                    "data units"
+                } else {
+                    &c.unit
+                },
+                c.fit.rms_log10_residual
+            ));
+            s.push_str(&format!(
+                "  {:<18} {:>11} {:>11} {:>11}  {}\n",
+                "term", "value", "lo", "hi", "unit"
+            ));
+            let mut rows: Vec<(String, f64, f64, f64, String)> = Vec::new();
+            let si_units = si_term_units(&c.unit);
+            for k in ALL_TERMS {
+                let label = term_label(k);
+                if let Some(t) = c.fit.term(k) {
+                    match display_units(c.quantity, k).first() {
+                        Some(&(u, size)) => rows.push((
+                            label.into(),
+                            t.value / size,
+                            t.lo / size,
+                            t.hi / size,
+                            u.into(),
+                        )),
+                        None => rows.push((label.into(), t.value, t.lo, t.hi, si_units(k))),
+                    }
+                }
+                if k == TermKind::GaussMarkov
+                    && let Some(g) = &c.fit.gauss_markov
+                {
+                    let t = g.tau_c_s;
+                    rows.push(("GM corr. time".into(), t.value, t.lo, t.hi, "s".into()));
+                }
+            }
+            for (label, v, lo, hi, u) in rows {
+                s.push_str(&format!(
+                    "  {:<18} {:>11} {:>11} {:>11}  {}\n",
+                    label,
+                    fmt_num(v),
+                    fmt_num(lo),
+                    fmt_num(hi),
+                    u
+                ));
+            }
+            for u in &c.fit.not_detected {
+                let (val, unit) = match display_units(c.quantity, u.term).first() {
+                    Some(&(name, size)) => (u.upper / size, name.to_string()),
+                    None => (u.upper, si_units(u.term)),
+                };
+                s.push_str(&format!(
+                    "  {:<18} not detected (< {} {})\n",
+                    term_label(u.term),
+                    fmt_num(val),
+                    unit
+                ));
+            }
+            let d = &c.discrete;
+            let su = if c.unit.is_empty() {
+                "u"
+            } else {
+                c.unit.as_str()
+            };
+            let mut parts = Vec::new();
+            if let Some(v) = d.white_sigma {
+                parts.push(format!("white σ_d = N·√fs = {} {su}", fmt_num(v)));
+            }
+            if let Some(v) = d.rate_random_walk_sigma {
+                parts.push(format!("RRW step σ = K·√Δt = {} {su}", fmt_num(v)));
+            }
+            if let Some(g) = &d.bias_instability_gm {
+                parts.push(format!(
+                    "bias-instability GM σ_b = {} {su}, T_c = {} s (φ = {}, σ_w = {} {su})",
+                    fmt_num(g.sigma),
+                    fmt_num(g.tau_c_s),
+                    fmt_num(g.phi),
+                    fmt_num(g.sigma_w)
+                ));
+            }
+            for p in parts {
+                s.push_str(&format!("  discrete: {p}\n"));
+            }
+        }
+        s
+    }
+
+    /// Serialise to TOML.
+    pub fn to_toml_string(&self) -> Result<String, NoiseModelError> {
+        Ok(toml::to_string_pretty(self)?)
+    }
+
+    /// Parse from TOML (errors name the source as `<string>`).
+    pub fn from_toml_str(s: &str) -> Result<NoiseModel, NoiseModelError> {
+        Self::parse(s, Path::new("<string>"))
+    }
+
+    fn parse(s: &str, path: &Path) -> Result<NoiseModel, NoiseModelError> {
+        let m: NoiseModel = toml::from_str(s).map_err(|e| NoiseModelError::Parse {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        })?;
+        let invalid = |why: String| NoiseModelError::Invalid {
+            path: path.to_path_buf(),
+            why,
+        };
+        if m.format_version == 0 || m.format_version > FORMAT_VERSION {
+            return Err(invalid(format!(
+                "format_version {} is not supported (this build reads 1..={FORMAT_VERSION})",
+                m.format_version
+            )));
+        }
+        if !(m.sample_rate_hz.is_finite() && m.sample_rate_hz > 0.0) {
+            return Err(invalid(format!(
+                "sample_rate_hz must be > 0, got {}",
+                m.sample_rate_hz
+            )));
+        }
+        for c in &m.channels {
+            for k in [
+                TermKind::Quantization,
+                TermKind::White,
+                TermKind::BiasInstability,
+                TermKind::RateRandomWalk,
+                TermKind::RateRamp,
+                TermKind::GaussMarkov,
+            ] {
+                if let Some(t) = c.fit.term(k)
+                    && !(t.value.is_finite() && t.value >= 0.0)
+                {
+                    return Err(invalid(format!(
+                        "channel '{}': {} = {} is not a finite non-negative value",
+                        c.name,
+                        k.name(),
+                        t.value
+                    )));
+                }
+            }
+        }
+        Ok(m)
+    }
+
+    /// Write the model to `path`.
+    pub fn save(&self, path: &Path) -> Result<(), NoiseModelError> {
+        let s = self.to_toml_string()?;
+        std::fs::write(path, s).map_err(|e| NoiseModelError::Write {
+            path: path.to_path_buf(),
+            source: e,
+        })
+    }
+
+    /// Read a model from `path`.
+    pub fn load(path: &Path) -> Result<NoiseModel, NoiseModelError> {
+        let s = std::fs::read_to_string(path).map_err(|e| NoiseModelError::Read {
+            path: path.to_path_buf(),
+            source: e,
+        })?;
+        Self::parse(&s, path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::allan::fit::{GaussMarkovTerm, UpperLimit};
+
+    fn term(v: f64) -> Option<Term> {
+        Some(Term {
+            value: v,
+            lo: 0.9 * v,
+            hi: 1.1 * v,
+        })
+    }
+
+    fn gyro_fit() -> NoiseFit {
+        NoiseFit {
+            quantization: None,
+            white: term(0.15 * DEG_PER_SQRT_H),
+            bias_instability: term(3.0 * DEG_PER_H),
+            rate_random_walk: term(0.5 * DEG_PER_H_PER_SQRT_H),
+            rate_ramp: None,
+            gauss_markov: Some(GaussMarkovTerm {
+                sigma: Term {
+                    value: 1e-5,
+                    lo: 5e-6,
+                    hi: 2e-5,
+                },
+                tau_c_s: Term {
+                    value: 100.0,
+                    lo: 50.0,
+                    hi: 200.0,
+                },
+            }),
+            confidence: 0.683,
+            rms_log10_residual: 0.01,
+            not_detected: vec![UpperLimit {
+                term: TermKind::RateRamp,
+                upper: 1e-9,
+            }],
+            chi2_reduced: 0.8,
+            n_points: 100,
+        }
+    }
+
+    #[test]
+    fn display_units_gyro() {
+        let d = display_terms(&gyro_fit(), Quantity::AngularRate);
+        let get = |u: &str| d.iter().find(|v| v.unit == u).unwrap().value;
+        assert!((get("deg/sqrt(h)") - 0.15).abs() < 1e-12);
+        assert!((get("deg/h") - 3.0).abs() < 1e-12);
+        assert!((get("deg/h/sqrt(h)") - 0.5).abs() < 1e-12);
+        // 0.15 deg/√h = 0.15/60 deg/√s = 0.0025 deg/s/√Hz
+        assert!((get("deg/s/sqrt(Hz)") - 0.0025).abs() < 1e-12);
+        let ramp = d.iter().find(|v| v.term == TermKind::RateRamp).unwrap();
+        assert!(!ramp.detected && ramp.value == 0.0 && ramp.hi > 0.0);
+    }
+
+    #[test]
+    fn display_units_accel() {
+        let n = 0.02 * M_PER_S_PER_SQRT_H;
+        let fit = NoiseFit {
+            white: term(n),
+            bias_instability: term(50.0 * MICRO_G),
+            rate_random_walk: term(1e-4),
+            ..gyro_fit()
+        };
+        let d = display_terms(&fit, Quantity::SpecificForce);
+        let get = |u: &str| d.iter().find(|v| v.unit == u).unwrap().value;
+        assert!((get("m/s/sqrt(h)") - 0.02).abs() < 1e-12);
+        assert!((get("mg") - 0.05).abs() < 1e-12);
+        assert!((get("ug") - 50.0).abs() < 1e-9);
+        assert!((get("m/s/h^1.5") - 1e-4 * 216_000.0).abs() < 1e-9);
+        // 0.02 m/s/√h = 3.33e-4 m/s²/√Hz = 34.0 µg/√Hz
+        assert!((get("ug/sqrt(Hz)") - n / MICRO_G).abs() < 1e-9);
+    }
+
+    #[test]
+    fn discrete_values() {
+        let fit = gyro_fit();
+        let d = discrete_noise(&fit, 100.0);
+        let n = fit.white.unwrap().value;
+        assert!((d.white_sigma.unwrap() - n * 10.0).abs() < 1e-15);
+        let k = fit.rate_random_walk.unwrap().value;
+        assert!((d.rate_random_walk_sigma.unwrap() - k * 0.1).abs() < 1e-18);
+        let gm = d.bias_instability_gm.unwrap();
+        // The GM stand-in peaks at the floor value.
+        let b = fit.bias_instability.unwrap().value;
+        let (_, peak) = gauss_markov_avar_peak();
+        assert!((gm.sigma * gm.sigma * peak / (BIAS_AVAR_COEF * b * b) - 1.0).abs() < 1e-9);
+        assert!((gm.sigma_w - gm.sigma * (1.0 - gm.phi * gm.phi).sqrt()).abs() < 1e-18);
+        assert!(gm.tau_c_s > 0.0 && gm.phi < 1.0);
+    }
+
+    #[test]
+    fn model_minimum_matches_closed_form() {
+        let fit = NoiseFit {
+            gauss_markov: None,
+            ..gyro_fit()
+        };
+        let n = fit.white.unwrap().value;
+        let k = fit.rate_random_walk.unwrap().value;
+        let t = model_minimum_tau(&fit);
+        assert!((t / (3f64.sqrt() * n / k) - 1.0).abs() < 1e-4, "{t}");
+    }
+
+    #[test]
+    fn toml_round_trip_and_errors() {
+        let mut m = NoiseModel::new(Some("log.csv".into()), 100.0, Some("oadev".into()));
+        m.channels.push(ChannelNoise::new(
+            "gyro_x",
+            Quantity::AngularRate,
+            gyro_fit(),
+            100.0,
+        ));
+        let mut acc = ChannelNoise::new("accel_z", Quantity::SpecificForce, gyro_fit(), 100.0);
+        acc.slope_readings = Some(SlopeReadings {
+            white: Some(1.0),
+            bias_instability: None,
+            tau_min: None,
+            rate_random_walk: Some(2.0),
+        });
+        m.channels.push(acc);
+        let s = m.to_toml_string().unwrap();
+        let back = NoiseModel::from_toml_str(&s).unwrap();
+        assert_eq!(back, m);
+        assert!(s.contains("gyro_x") && s.contains("deg/sqrt(h)"));
+
+        let dir = std::env::temp_dir().join(format!("driftless-nm-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("model.toml");
+        m.save(&p).unwrap();
+        assert_eq!(NoiseModel::load(&p).unwrap(), m);
+
+        let missing = dir.join("missing.toml");
+        let e = NoiseModel::load(&missing).unwrap_err();
+        assert!(e.to_string().contains("missing.toml"), "{e}");
+        std::fs::write(&p, "format_version = 1\nsample_rate_hz = \"x\"\n").unwrap();
+        let e = NoiseModel::load(&p).unwrap_err();
+        assert!(matches!(e, NoiseModelError::Parse { .. }));
+        assert!(e.to_string().contains("model.toml"), "{e}");
+        std::fs::write(
+            &p,
+            "format_version = 9\nsample_rate_hz = 100.0\nchannels = []\n",
+        )
+        .unwrap();
+        assert!(matches!(
+            NoiseModel::load(&p).unwrap_err(),
+            NoiseModelError::Invalid { .. }
+        ));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

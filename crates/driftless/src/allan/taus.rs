@@ -59,7 +59,10 @@ impl FromStr for TauSpec {
                 ))
             })?;
             if !(v.is_finite() && v > 0.0) {
-                return Err(bad(&format!("item {} ('{p}') must be a positive tau in seconds", i + 1)));
+                return Err(bad(&format!(
+                    "item {} ('{p}') must be a positive tau in seconds",
+                    i + 1
+                )));
             }
             taus.push(v);
         }

@@ -391,7 +391,15 @@ fn read_impl<R: Read>(
         columns = names
             .par_iter()
             .enumerate()
-            .map(|(i, name)| read_column_at(file, data_start + i as u64 * col_bytes, h.rows, name, source))
+            .map(|(i, name)| {
+                read_column_at(
+                    file,
+                    data_start + i as u64 * col_bytes,
+                    h.rows,
+                    name,
+                    source,
+                )
+            })
             .collect::<Result<Vec<_>, _>>()?;
     }
     #[cfg(not(unix))]
@@ -400,7 +408,11 @@ fn read_impl<R: Read>(
         let mut block = vec![0u8; IO_BLOCK];
         for name in &names {
             // Trust the row count for capacity only when the file size confirmed it.
-            let cap = if size.is_some() { h.rows } else { h.rows.min(1 << 20) };
+            let cap = if size.is_some() {
+                h.rows
+            } else {
+                h.rows.min(1 << 20)
+            };
             let mut v: Vec<f64> = Vec::with_capacity(cap);
             let mut finite = true;
             while v.len() < h.rows {

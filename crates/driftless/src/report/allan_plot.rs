@@ -3,8 +3,7 @@
 //! with its value (IEEE Std 952-1997 Annex C slopes: Q −1, N −½, B 0, K +½, R +1).
 
 use super::plot::{
-    Annotation, Color, Figure, Line, LogLogPlot, PALETTE, PlotError, Series, render_png,
-    write_svg,
+    Annotation, Color, Figure, Line, LogLogPlot, PALETTE, PlotError, Series, render_png, write_svg,
 };
 use crate::allan::analysis::ChannelResult;
 use crate::allan::fit::{NoiseFit, gauss_markov_avar};
@@ -75,6 +74,32 @@ pub fn figure(
         let dev: Vec<f64> = r.points.iter().map(|p| p.dev * k).collect();
         let lo: Vec<f64> = r.dev_lo.iter().map(|v| v * k).collect();
         let hi: Vec<f64> = r.dev_hi.iter().map(|v| v * k).collect();
+        // y range: the data with its bars, extended down to the flicker floor 0.664·B,
+        // which lies below the curve's minimum (white noise and rate random walk still add
+        // there) and would otherwise be clipped away.
+        let pos = |v: &f64| v.is_finite() && *v > 0.0;
+        let data_min = dev
+            .iter()
+            .chain(&lo)
+            .copied()
+            .filter(pos)
+            .fold(f64::INFINITY, f64::min);
+        let data_max = dev
+            .iter()
+            .chain(&hi)
+            .copied()
+            .filter(pos)
+            .fold(0.0, f64::max);
+        let floor = fits
+            .get(i)
+            .copied()
+            .flatten()
+            .and_then(|f| f.bias_instability)
+            .map(|t| (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt() * t.value * k);
+        let y_range = (data_min.is_finite() && data_max > 0.0).then(|| {
+            let bottom = floor.filter(pos).map_or(data_min, |f| f.min(data_min));
+            (bottom / 1.3, data_max * 1.3)
+        });
         let (tmin, tmax) = (
             tau.first().copied().unwrap_or(1.0),
             tau.last().copied().unwrap_or(10.0),
@@ -112,20 +137,55 @@ pub fn figure(
             };
             let geo = |a: f64, b: f64| (a * b).sqrt();
             if let Some(t) = f.quantization {
-                asym("Q asymptote", 'Q', t.value, 3f64.sqrt() * t.value, -1.0, tmin * 2.0);
+                asym(
+                    "Q asymptote",
+                    'Q',
+                    t.value,
+                    3f64.sqrt() * t.value,
+                    -1.0,
+                    tmin * 2.0,
+                );
             }
             if let Some(t) = f.white {
-                asym("N asymptote", 'N', t.value, t.value, -0.5, geo(tmin, geo(tmin, tmax)));
+                asym(
+                    "N asymptote",
+                    'N',
+                    t.value,
+                    t.value,
+                    -0.5,
+                    geo(tmin, geo(tmin, tmax)),
+                );
             }
             if let Some(t) = f.bias_instability {
                 let c = (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt();
-                asym("B asymptote", 'B', t.value, c * t.value, 0.0, geo(tmin, tmax));
+                asym(
+                    "B asymptote",
+                    'B',
+                    t.value,
+                    c * t.value,
+                    0.0,
+                    geo(tmin, tmax),
+                );
             }
             if let Some(t) = f.rate_random_walk {
-                asym("K asymptote", 'K', t.value, t.value / 3f64.sqrt(), 0.5, geo(geo(tmin, tmax), tmax));
+                asym(
+                    "K asymptote",
+                    'K',
+                    t.value,
+                    t.value / 3f64.sqrt(),
+                    0.5,
+                    geo(geo(tmin, tmax), tmax),
+                );
             }
             if let Some(t) = f.rate_ramp {
-                asym("R asymptote", 'R', t.value, t.value / 2f64.sqrt(), 1.0, tmax / 2.0);
+                asym(
+                    "R asymptote",
+                    'R',
+                    t.value,
+                    t.value / 2f64.sqrt(),
+                    1.0,
+                    tmax / 2.0,
+                );
             }
             if let Some(gm) = f.gauss_markov {
                 let (s, tc) = (gm.sigma.value, gm.tau_c_s.value);
@@ -137,7 +197,11 @@ pub fn figure(
                     Line::new("Gauss-Markov term", tau.clone(), y)
                         .dashed()
                         .with_color(grey)
-                        .with_label(format!("GM σ = {}, T = {} s", format_sig(s * k), format_sig(tc))),
+                        .with_label(format!(
+                            "GM σ = {}, T = {} s",
+                            format_sig(s * k),
+                            format_sig(tc)
+                        )),
                 );
             }
             // Mark the curve's minimum (where bias instability is read classically).
@@ -150,6 +214,7 @@ pub fn figure(
                 plot = plot.with_annotation(Annotation::new("minimum", tau[j], dev[j]));
             }
         }
+        plot.y_range = y_range;
         panels.push(plot);
     }
     let cols = match panels.len() {

@@ -1,3 +1,8 @@
 //! Simulation with known truth.
 //!
-//! OWNER: helper "fit" (rng + static noise generator for issue 2).
+//! * [`rng`]: seedable xoshiro256++ generator with a ziggurat standard normal.
+//! * [`noise`]: static IMU noise (quantization, white, bias instability, rate random walk,
+//!   rate ramp, Gauss-Markov, turn-on bias) following IEEE Std 952-1997 Annex C.
+
+pub mod noise;
+pub mod rng;

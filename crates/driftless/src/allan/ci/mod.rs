@@ -208,9 +208,22 @@ pub fn identify_noise(
             "noise identification needs an averaging factor m ≥ 1".into(),
         ));
     }
-    if let Some((index, &value)) = phase.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        return Err(AllanError::NonFinite { index, value });
-    }
+    // The methods below read only every k-th phase point (k = m, or a coarser stride in
+    // the fallbacks), at most MAX_ACF_POINTS of them: check exactly those, so a 10⁷-point
+    // log is not rescanned per tau.
+    let check = |k: usize| -> Result<(), AllanError> {
+        match phase
+            .iter()
+            .enumerate()
+            .step_by(k.max(1))
+            .take(noise_id::MAX_ACF_POINTS)
+            .find(|(_, v)| !v.is_finite())
+        {
+            Some((index, &value)) => Err(AllanError::NonFinite { index, value }),
+            None => Ok(()),
+        }
+    };
+    check(m)?;
     let dmax = if estimator.is_hadamard() { 3 } else { 2 };
     let (lo, hi) = alpha_range(estimator);
     let clamp = |mut id: NoiseId| {
@@ -225,10 +238,12 @@ pub fn identify_noise(
     }
     if phase.len() >= noise_id::MIN_ACF_POINTS {
         let m_acf = ((phase.len() - 1) / (noise_id::MIN_ACF_POINTS - 1)).max(1);
+        check(m_acf)?;
         if let Some(id) = acf_noise_id(phase, m_acf, dmax) {
             return Ok(clamp(id));
         }
     }
+    check(1)?;
     if let Some(id) = b1_noise_id(phase, 1) {
         return Ok(clamp(id));
     }

@@ -1,0 +1,195 @@
+//! `driftless bench`: the speed figures of BENCHMARKS.md, measured on this machine.
+//!
+//! Generates an 18-h, 100 Hz, 7-column log (time + 6 axes; 6.48 M rows) in a temporary
+//! folder, then times, best and median of `--runs`:
+//! * text parse of the CSV (MB/s), binary DRIFTLOG read (MB/s);
+//! * exact overlapping ADEV of the six channels on `log:100` taus, with and without CIs;
+//! * the opt-in fast (reduced-overlap) OADEV.
+
+use anyhow::{Context, Result};
+use clap::Args;
+use driftless::allan::analysis::{AnalysisConfig, analyse_channels};
+use driftless::allan::phase::frequency_to_phase;
+use driftless::allan::taus::{TauSpec, averaging_factors};
+use driftless::allan::{DataType, Estimator, estimators};
+use driftless::io::{Channel, ImuLog, Quantity, TextOptions};
+use driftless::sim::noise::{StaticNoiseConfig, generate_channels};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Hours of 100 Hz data per channel.
+    #[arg(long, default_value_t = 18.0)]
+    pub hours: f64,
+    /// Repetitions per measurement.
+    #[arg(long, default_value_t = 5)]
+    pub runs: usize,
+    /// Where to write the generated logs (deleted afterwards unless --keep).
+    #[arg(long, default_value = "/tmp/driftless-bench")]
+    pub dir: PathBuf,
+    /// Keep the generated CSV and binary logs (for the allantools comparison).
+    #[arg(long)]
+    pub keep: bool,
+    /// Skip the text/binary parse benchmarks.
+    #[arg(long)]
+    pub no_io: bool,
+    /// Print results as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn time_runs<T>(runs: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f64, f64)> {
+    let mut v = Vec::with_capacity(runs);
+    for _ in 0..runs.max(1) {
+        let t = Instant::now();
+        let r = f()?;
+        v.push(t.elapsed().as_secs_f64());
+        drop(r);
+    }
+    v.sort_by(f64::total_cmp);
+    Ok((v[0], v[v.len() / 2]))
+}
+
+pub fn run(a: BenchArgs) -> Result<()> {
+    let rate = 100.0;
+    let n = (a.hours * 3600.0 * rate).round() as usize;
+    let cfg = StaticNoiseConfig {
+        sample_rate_hz: rate,
+        duration_s: n as f64 / rate,
+        white: 1e-3,
+        rate_random_walk: 1e-6,
+        ..StaticNoiseConfig::default()
+    };
+    eprintln!("generating 6 × {n} samples …");
+    let data = generate_channels(&vec![cfg; 6], 7)?;
+    let names = ["gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z"];
+    let channels: Vec<Channel> = names
+        .iter()
+        .zip(data)
+        .map(|(nm, values)| Channel {
+            name: nm.to_string(),
+            quantity: if nm.starts_with("gyro") {
+                Quantity::AngularRate
+            } else {
+                Quantity::SpecificForce
+            },
+            source_unit: if nm.starts_with("gyro") {
+                "rad/s"
+            } else {
+                "m/s^2"
+            }
+            .into(),
+            values,
+        })
+        .collect();
+    let time: Vec<f64> = (0..n).map(|i| i as f64 / rate).collect();
+    let log = ImuLog::new("bench", Some(time), 1.0 / rate, channels);
+    let mut results: Vec<(String, f64, f64, String)> = Vec::new();
+
+    if !a.no_io {
+        std::fs::create_dir_all(&a.dir).with_context(|| format!("creating {}", a.dir.display()))?;
+        let csv = a.dir.join("static_18h.csv");
+        let bin = a.dir.join("static_18h.dlog");
+        eprintln!("writing {} and {} …", csv.display(), bin.display());
+        driftless::io::write_csv_file(&log, &csv)?;
+        driftless::io::write_binary_file(&log, &bin)?;
+        let csv_mb = std::fs::metadata(&csv)?.len() as f64 / 1e6;
+        let bin_mb = std::fs::metadata(&bin)?.len() as f64 / 1e6;
+        let opts = TextOptions {
+            time_column: Some(driftless::io::ColumnRef::Index(1)),
+            ..TextOptions::default()
+        };
+        let (best, med) = time_runs(a.runs, || Ok(driftless::io::read_text_file(&csv, &opts)?))?;
+        results.push((
+            format!("text parse, {csv_mb:.0} MB CSV (7 columns)"),
+            best,
+            med,
+            format!("{:.0} MB/s", csv_mb / best),
+        ));
+        let (bbest, bmed) = time_runs(a.runs, || Ok(driftless::io::read_binary_file(&bin)?))?;
+        results.push((
+            format!("binary DRIFTLOG read, {bin_mb:.0} MB"),
+            bbest,
+            bmed,
+            format!(
+                "{:.0} MB/s, {:.1}x faster than text",
+                bin_mb / bbest,
+                best / bbest
+            ),
+        ));
+        if !a.keep {
+            let _ = std::fs::remove_file(&csv);
+            let _ = std::fs::remove_file(&bin);
+        }
+    }
+
+    let ms = averaging_factors(&TauSpec::Log(100), 1.0 / rate, n + 1, Estimator::Oadev)?;
+    let phases: Vec<Vec<f64>> = log
+        .channels
+        .iter()
+        .map(|c| frequency_to_phase(&c.values, 1.0 / rate))
+        .collect();
+    let (best, med) = time_runs(a.runs, || {
+        use rayon::prelude::*;
+        Ok(phases
+            .par_iter()
+            .map(|x| estimators::sums(Estimator::Oadev, x, &ms))
+            .collect::<Vec<_>>())
+    })?;
+    results.push((
+        format!("exact OADEV, 6 ch × {n}, {} taus (sums only)", ms.len()),
+        best,
+        med,
+        String::new(),
+    ));
+    let inputs: Vec<(&str, Vec<&[f64]>)> = log
+        .channels
+        .iter()
+        .map(|c| (c.name.as_str(), vec![c.values.as_slice()]))
+        .collect();
+    for (fast, label) in [(false, "exact"), (true, "fast")] {
+        let cfg = AnalysisConfig {
+            estimator: Estimator::Oadev,
+            taus: TauSpec::Log(100),
+            data_type: DataType::Frequency,
+            alpha: None,
+            confidence: 0.683,
+            fast,
+        };
+        let (best, med) = time_runs(a.runs, || Ok(analyse_channels(&inputs, 1.0 / rate, &cfg)?))?;
+        results.push((
+            format!("{label} OADEV + noise ID + EDF/CI, 6 ch, log:100, from rates"),
+            best,
+            med,
+            String::new(),
+        ));
+    }
+
+    if a.json {
+        let v: Vec<serde_json::Value> = results
+            .iter()
+            .map(|(w, b, m, note)| serde_json::json!({"what": w, "best_s": b, "median_s": m, "note": note}))
+            .collect();
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        let mut t = crate::output::Table::new(["benchmark", "best [s]", "median [s]", "note"]);
+        for (w, b, m, note) in &results {
+            t.row(vec![
+                w.clone(),
+                format!("{b:.3}"),
+                format!("{m:.3}"),
+                note.clone(),
+            ]);
+        }
+        print!("{}", t.render());
+        println!(
+            "machine: {} cores (rayon threads: {})",
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1),
+            rayon::current_num_threads()
+        );
+    }
+    Ok(())
+}

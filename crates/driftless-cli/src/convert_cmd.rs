@@ -1,0 +1,39 @@
+//! `driftless convert`: delimited text ↔ compact binary log.
+
+use crate::input::InputArgs;
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct ConvertArgs {
+    /// Input log (text or binary).
+    pub input: PathBuf,
+    /// Output: `.dlog` (binary DRIFTLOG) or `.csv`.
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub read: InputArgs,
+}
+
+pub fn run(a: ConvertArgs) -> Result<()> {
+    let log = crate::allan_cmd::read_with_progress(&a.read, &a.input, false)?;
+    let ext = a
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "csv" | "txt" => driftless::io::write_csv_file(&log, &a.output),
+        _ => driftless::io::write_binary_file(&log, &a.output),
+    }
+    .with_context(|| format!("writing {}", a.output.display()))?;
+    eprintln!(
+        "{} → {}: {} channels × {} samples",
+        a.input.display(),
+        a.output.display(),
+        log.channels.len(),
+        log.len()
+    );
+    Ok(())
+}
