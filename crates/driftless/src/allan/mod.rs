@@ -116,7 +116,8 @@ pub struct DevPoint {
 pub enum AllanError {
     /// Too few samples for even the smallest averaging factor requested.
     #[error(
-        "{estimator} at tau = {tau} s (m = {m}) needs at least {needed} samples; the log has {have}"
+        "{estimator} at tau = {t} s (m = {m}) needs at least {needed} samples; the log has {have}",
+        t = crate::io::error::sig6(*tau)
     )]
     TooFewSamples {
         /// Estimator name.

@@ -156,7 +156,9 @@ pub enum LogError {
     },
     /// A gap in time larger than the configured factor times τ0 (with `GapPolicy::Error`).
     #[error(
-        "{at}: time gap of {duration_s} s before this row ({ratio:.1} × τ0 = {tau0_s} s, limit {gap_factor} × τ0) in column {field} ({name}); choose gap policy `split` or `bridge` to accept gaps"
+        "{at}: time gap of {d} s before this row ({ratio:.1} × τ0, τ0 = {t} s, limit {gap_factor} × τ0) in column {field} ({name}); accept gaps with the gap policy `split` or `bridge` (CLI: --gaps split|bridge)",
+        d = crate::io::error::sig6(*duration_s),
+        t = crate::io::error::sig6(*tau0_s)
     )]
     TimeGap {
         /// Where (the first row after the gap).
@@ -358,5 +360,19 @@ pub(crate) fn excerpt(bytes: &[u8]) -> String {
         t
     } else {
         s.into_owned()
+    }
+}
+
+/// A number with at most 6 significant digits, trailing zeros dropped (for messages).
+pub fn sig6(v: f64) -> String {
+    if !v.is_finite() || v == 0.0 {
+        return format!("{v}");
+    }
+    let digits = (5 - v.abs().log10().floor() as i32).clamp(0, 15) as usize;
+    let s = format!("{v:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
     }
 }

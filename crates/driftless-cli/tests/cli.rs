@@ -1,0 +1,406 @@
+//! End-to-end tests of the `driftless` binary: the `allan --json` contract, bad input
+//! (one clear error naming file, line and column; exit code ≠ 0; nothing on stdout), and
+//! gap handling.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_driftless"))
+}
+
+fn data_dir() -> PathBuf {
+    match std::env::var_os("DRIFTLESS_DATA") {
+        Some(p) => PathBuf::from(p),
+        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
+    }
+}
+
+fn tmp_file(name: &str, contents: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("driftless-cli-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, contents).unwrap();
+    p
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("run driftless")
+}
+
+/// Runs and expects failure with exactly one error line naming `needle`s; stdout empty.
+fn expect_error(args: &[&str], needles: &[&str]) -> String {
+    let out = run(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(
+        !out.status.success(),
+        "expected failure for {args:?}; stderr: {stderr}"
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "partial output on stdout for {args:?}: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "one error line expected: {stderr}");
+    for n in needles {
+        assert!(stderr.contains(n), "error should mention {n:?}: {stderr}");
+    }
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr
+}
+
+fn csv_with_time(rows: &[&str]) -> String {
+    let mut s = String::from("time,gyro_x,gyro_y\n");
+    for r in rows {
+        s.push_str(r);
+        s.push('\n');
+    }
+    s
+}
+
+/// A clean 3-column CSV with `n` rows at 100 Hz.
+fn good_rows(n: usize) -> Vec<String> {
+    (0..n)
+        .map(|i| {
+            let t = i as f64 * 0.01;
+            format!(
+                "{t:.2},{:.6},{:.6}",
+                ((i * 7919) % 101) as f64 * 1e-3,
+                ((i * 104_729) % 97) as f64 * 1e-3
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn non_numeric_field_names_line_and_column() {
+    let mut rows = good_rows(50);
+    rows[9] = "0.09,0.001,abc".into();
+    let refs: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let p = tmp_file("nonnum.csv", &csv_with_time(&refs));
+    let path = p.display().to_string();
+    // header is line 1, row index 9 is line 11; "abc" starts at byte column 12
+    expect_error(
+        &["allan", &path, "--time-column", "time"],
+        &[&format!("{path}:11:12"), "abc", "gyro_y"],
+    );
+}
+
+#[test]
+fn ragged_row() {
+    let mut rows = good_rows(50);
+    rows[4] = "0.04,0.001".into();
+    let refs: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let p = tmp_file("ragged.csv", &csv_with_time(&refs));
+    let path = p.display().to_string();
+    expect_error(
+        &["allan", &path, "--time-column", "time"],
+        &[&format!("{path}:6:")],
+    );
+}
+
+#[test]
+fn nan_and_inf_values() {
+    for (name, bad) in [("nan.csv", "NaN"), ("inf.csv", "inf")] {
+        let mut rows = good_rows(50);
+        rows[20] = format!("0.20,{bad},0.001");
+        let refs: Vec<&str> = rows.iter().map(String::as_str).collect();
+        let p = tmp_file(name, &csv_with_time(&refs));
+        let path = p.display().to_string();
+        expect_error(
+            &["allan", &path, "--time-column", "time"],
+            &[&format!("{path}:22:6")],
+        );
+    }
+}
+
+#[test]
+fn non_monotonic_and_duplicated_timestamps() {
+    let mut rows = good_rows(50);
+    rows[30] = "0.25,0.001,0.002".into();
+    let refs: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let p = tmp_file("backwards.csv", &csv_with_time(&refs));
+    let path = p.display().to_string();
+    expect_error(
+        &["allan", &path, "--time-column", "time"],
+        &[&format!("{path}:32")],
+    );
+
+    let mut rows = good_rows(50);
+    rows[30] = "0.29,0.001,0.002".into();
+    let refs: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let p = tmp_file("dup.csv", &csv_with_time(&refs));
+    let path = p.display().to_string();
+    expect_error(
+        &["allan", &path, "--time-column", "time"],
+        &[&format!("{path}:32")],
+    );
+}
+
+#[test]
+fn gaps_error_by_default_and_split_or_bridge_on_request() {
+    // 400 rows, then a 1-s gap, then 400 rows
+    let mut rows = good_rows(400);
+    for i in 0..400 {
+        let t = 5.0 + i as f64 * 0.01;
+        rows.push(format!(
+            "{t:.2},{:.6},{:.6}",
+            ((i * 31) % 17) as f64 * 1e-3,
+            ((i * 13) % 11) as f64 * 1e-3
+        ));
+    }
+    let refs: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let p = tmp_file("gap.csv", &csv_with_time(&refs));
+    let path = p.display().to_string();
+    expect_error(
+        &["allan", &path, "--time-column", "time"],
+        &[&format!("{path}:402")],
+    );
+
+    for policy in ["split", "bridge"] {
+        let out = run(&[
+            "allan",
+            &path,
+            "--time-column",
+            "time",
+            "--gaps",
+            policy,
+            "--taus",
+            "0.01,0.1",
+            "--no-fit",
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{policy}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let n0 = v["channels"][0]["n"][0].as_u64().unwrap();
+        // split: no second difference straddles the gap → (400−2)+(400−2) terms at m=1
+        // from two segments of 400 rates (401 phase points each); bridge: 800 rates → 799.
+        let want = if policy == "split" {
+            2 * (401 - 2)
+        } else {
+            801 - 2
+        };
+        assert_eq!(n0, want as u64, "{policy}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.contains("gap"),
+            "{policy} should warn about the gap: {stderr}"
+        );
+    }
+}
+
+#[test]
+fn too_few_samples_for_a_tau() {
+    let rows = good_rows(50);
+    let refs: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let p = tmp_file("short.csv", &csv_with_time(&refs));
+    let path = p.display().to_string();
+    expect_error(
+        &[
+            "allan",
+            &path,
+            "--time-column",
+            "time",
+            "--taus",
+            "0.01,100",
+        ],
+        &[&path, "tau = 100", "needs at least"],
+    );
+}
+
+#[test]
+fn empty_file_and_header_only() {
+    let p = tmp_file("empty.csv", "");
+    let path = p.display().to_string();
+    expect_error(&["allan", &path, "--rate", "100"], &[&path]);
+    let p = tmp_file("comments.csv", "# only a comment\n\n");
+    let path = p.display().to_string();
+    expect_error(&["allan", &path, "--rate", "100"], &[&path]);
+    let p = tmp_file("header.csv", "time,gyro_x\n");
+    let path = p.display().to_string();
+    expect_error(&["allan", &path, "--time-column", "time"], &[&path]);
+}
+
+#[test]
+fn missing_file_and_bad_flags() {
+    expect_error(
+        &["allan", "/nonexistent/x.csv", "--rate", "1"],
+        &["/nonexistent/x.csv"],
+    );
+    let rows = good_rows(50);
+    let refs: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let p = tmp_file("ok.csv", &csv_with_time(&refs));
+    let path = p.display().to_string();
+    expect_error(
+        &["allan", &path, "--time-column", "time", "--taus", "log:x"],
+        &["log:x"],
+    );
+    expect_error(
+        &[
+            "allan",
+            &path,
+            "--time-column",
+            "time",
+            "--estimator",
+            "xdev",
+        ],
+        &["xdev"],
+    );
+    expect_error(
+        &[
+            "allan",
+            &path,
+            "--time-column",
+            "time",
+            "--column",
+            "gyro_x:furlongs",
+        ],
+        &["furlongs"],
+    );
+    expect_error(&["allan", &path, "--time-column", "nope"], &["nope"]);
+}
+
+#[test]
+fn units_are_converted_at_the_edge() {
+    // the same data in deg/s and in rad/s must give the same deviations in rad/s
+    let rows = good_rows(2000);
+    let refs: Vec<&str> = rows.iter().map(String::as_str).collect();
+    let p = tmp_file("deg.csv", &csv_with_time(&refs));
+    let path = p.display().to_string();
+    let json = |unit: &str| -> serde_json::Value {
+        let out = run(&[
+            "allan",
+            &path,
+            "--time-column",
+            "time",
+            "--unit",
+            unit,
+            "--taus",
+            "octave",
+            "--no-fit",
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let deg = json("deg/s");
+    let rad = json("rad/s");
+    let d = deg["channels"][0]["dev"].as_array().unwrap();
+    let r = rad["channels"][0]["dev"].as_array().unwrap();
+    for (a, b) in d.iter().zip(r) {
+        let (a, b) = (a.as_f64().unwrap(), b.as_f64().unwrap());
+        assert!((a / b - std::f64::consts::PI / 180.0).abs() < 1e-12);
+    }
+    assert_eq!(deg["channels"][0]["unit"], "rad/s");
+}
+
+fn stable32_rows(path: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+        .map(|l| l.split_whitespace().map(|f| f.parse().unwrap()).collect())
+        .collect()
+}
+
+/// The machine-readable contract, through the binary, on Stable32 reference data.
+#[test]
+#[ignore = "needs shared data"]
+fn json_contract_matches_stable32() {
+    let d = data_dir().join("allan");
+    let cases: [(&str, &str, &[&str], &str, f64); 3] = [
+        (
+            "phasedat/PHASE.DAT",
+            "phase",
+            &[],
+            "phasedat/phase_dat_oadev_octave.txt",
+            1e-4,
+        ),
+        (
+            "ocxo/ocxo_frequency.txt",
+            "freq",
+            &["--scale", "1e-7"],
+            "ocxo/adev_octave.txt",
+            2e-3,
+        ),
+        (
+            "pink_frequency/pink_frequency.txt",
+            "freq",
+            &[],
+            "pink_frequency/s32_oadev_octave.txt",
+            1e-4,
+        ),
+    ];
+    for (input, dtype, extra, result, tol) in cases {
+        let est = if result.contains("_adev") || result.starts_with("ocxo/adev") {
+            "adev"
+        } else {
+            "oadev"
+        };
+        let input = d.join(input).display().to_string();
+        let mut args = vec![
+            "allan",
+            &input,
+            "--data-type",
+            dtype,
+            "--rate",
+            "1",
+            "--taus",
+            "octave",
+            "--estimator",
+            est,
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let out = run(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let ch = &v["channels"][0];
+        for key in [
+            "name",
+            "estimator",
+            "tau",
+            "m",
+            "n",
+            "dev",
+            "dev_lo",
+            "dev_hi",
+            "alpha",
+        ] {
+            assert!(!ch[key].is_null(), "missing {key}");
+        }
+        assert!(v.get("noise").is_some());
+        assert_eq!(ch["estimator"], est);
+        let rows = stable32_rows(&d.join(result));
+        let n = ch["n"].as_array().unwrap();
+        let dev = ch["dev"].as_array().unwrap();
+        assert_eq!(n.len(), rows.len(), "{result}: number of taus");
+        for (i, r) in rows.iter().enumerate() {
+            assert_eq!(ch["m"][i].as_u64().unwrap() as f64, r[0]);
+            assert_eq!(n[i].as_u64().unwrap() as f64, r[2], "{result} row {i}");
+            let got = dev[i].as_f64().unwrap();
+            assert!(
+                (got - r[5]).abs() / r[5] < tol,
+                "{result} row {i}: {got} vs {}",
+                r[5]
+            );
+            let lo = ch["dev_lo"][i].as_f64().unwrap();
+            let hi = ch["dev_hi"][i].as_f64().unwrap();
+            assert!(lo < got && got < hi);
+        }
+    }
+}
