@@ -95,6 +95,7 @@ pub fn figure(
             .copied()
             .flatten()
             .and_then(|f| f.bias_instability)
+            .filter(|t| t.lo > 0.0)
             .map(|t| (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt() * t.value * k);
         let y_range = (data_min.is_finite() && data_max > 0.0).then(|| {
             let bottom = floor.filter(pos).map_or(data_min, |f| f.min(data_min));
@@ -127,6 +128,9 @@ pub fn figure(
             .with_color(Color::rgb(0x20, 0x20, 0x20));
             plot = plot.with_line(model);
             let grey = Color::rgb(0x70, 0x70, 0x70);
+            // Draw only terms whose interval excludes zero; the others are listed in the
+            // noise table with their intervals.
+            let significant = |t: &crate::allan::fit::Term| t.lo > 0.0;
             let mut asym = |name: &str, term: char, v: f64, coeff: f64, exp: f64, at: f64| {
                 let l = Line::power_law(name, coeff * k, exp, tmin, tmax, 32)
                     .dashed()
@@ -136,7 +140,7 @@ pub fn figure(
                 plot.lines.push(l);
             };
             let geo = |a: f64, b: f64| (a * b).sqrt();
-            if let Some(t) = f.quantization {
+            if let Some(t) = f.quantization.filter(significant) {
                 asym(
                     "Q asymptote",
                     'Q',
@@ -146,7 +150,7 @@ pub fn figure(
                     tmin * 2.0,
                 );
             }
-            if let Some(t) = f.white {
+            if let Some(t) = f.white.filter(significant) {
                 asym(
                     "N asymptote",
                     'N',
@@ -156,7 +160,7 @@ pub fn figure(
                     geo(tmin, geo(tmin, tmax)),
                 );
             }
-            if let Some(t) = f.bias_instability {
+            if let Some(t) = f.bias_instability.filter(significant) {
                 let c = (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt();
                 asym(
                     "B asymptote",
@@ -167,7 +171,7 @@ pub fn figure(
                     geo(tmin, tmax),
                 );
             }
-            if let Some(t) = f.rate_random_walk {
+            if let Some(t) = f.rate_random_walk.filter(significant) {
                 asym(
                     "K asymptote",
                     'K',
@@ -177,7 +181,7 @@ pub fn figure(
                     geo(geo(tmin, tmax), tmax),
                 );
             }
-            if let Some(t) = f.rate_ramp {
+            if let Some(t) = f.rate_ramp.filter(significant) {
                 asym(
                     "R asymptote",
                     'R',
@@ -187,7 +191,7 @@ pub fn figure(
                     tmax / 2.0,
                 );
             }
-            if let Some(gm) = f.gauss_markov {
+            if let Some(gm) = f.gauss_markov.filter(|g| significant(&g.sigma)) {
                 let (s, tc) = (gm.sigma.value, gm.tau_c_s.value);
                 let y: Vec<f64> = tau
                     .iter()

@@ -9,12 +9,12 @@
 /// Fewest points the lag-1 ACF method is used on (Riley & Greenhall recommend ≥ 30).
 pub const MIN_ACF_POINTS: usize = 30;
 
-/// Most decimated points the lag-1 ACF is computed on (the first ones). With 2¹⁶ points
-/// the standard error of r1 is ≈ 1/√n ≈ 0.004, two orders of magnitude below the method's
+/// Most decimated points the lag-1 ACF is computed on (the first ones). With 2¹⁴ points
+/// the standard error of r1 is ≈ 1/√n ≈ 0.008, thirty times below the method's
 /// decision margins (δ thresholds 0.25 apart), while an 18-h 100 Hz log would otherwise be
 /// re-read in full for every small averaging factor. Shorter series are used whole, so
 /// results on Stable32-sized data are unchanged.
-pub const MAX_ACF_POINTS: usize = 1 << 16;
+pub const MAX_ACF_POINTS: usize = 1 << 14;
 
 /// Fewest frequency averages the B1 ratio is used on (with 2 it is identically 1).
 pub const MIN_B1_POINTS: usize = 4;
