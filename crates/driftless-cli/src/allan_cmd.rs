@@ -69,31 +69,6 @@ pub struct AllanArgs {
     pub input: InputArgs,
 }
 
-/// Parse `--terms`.
-pub fn parse_terms(s: &str) -> Result<FitConfig> {
-    let mut c = FitConfig {
-        quantization: false,
-        white: false,
-        bias_instability: false,
-        rate_random_walk: false,
-        rate_ramp: false,
-        gauss_markov: false,
-    };
-    for t in s.split(',').map(|t| t.trim().to_ascii_lowercase()) {
-        match t.as_str() {
-            "q" => c.quantization = true,
-            "n" => c.white = true,
-            "b" => c.bias_instability = true,
-            "k" => c.rate_random_walk = true,
-            "r" => c.rate_ramp = true,
-            "gm" => c.gauss_markov = true,
-            "" => {}
-            other => bail!("--terms: unknown term {other:?} (expected q, n, b, k, r, gm)"),
-        }
-    }
-    Ok(c)
-}
-
 /// Everything `allan` computes for one log.
 pub struct AllanOutput {
     pub results: Vec<ChannelResult>,
@@ -225,7 +200,7 @@ pub fn run(a: AllanArgs) -> Result<()> {
     let fit = if a.no_fit {
         None
     } else {
-        Some(parse_terms(&a.terms)?)
+        Some(a.terms.parse::<FitConfig>().context("--terms")?)
     };
     let log = read_with_progress(&a.input, &a.file, a.json)?;
     for g in &log.gaps {

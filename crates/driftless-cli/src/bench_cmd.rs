@@ -92,7 +92,12 @@ pub fn run(a: BenchArgs) -> Result<()> {
         let csv = a.dir.join("static_18h.csv");
         let csv_full = a.dir.join("static_18h_full.csv");
         let bin = a.dir.join("static_18h.dlog");
-        eprintln!("writing {}, {} and {} …", csv.display(), csv_full.display(), bin.display());
+        eprintln!(
+            "writing {}, {} and {} …",
+            csv.display(),
+            csv_full.display(),
+            bin.display()
+        );
         write_logger_csv(&log, &csv)?;
         driftless::io::write_csv_file(&log, &csv_full)?;
         driftless::io::write_binary_file(&log, &bin)?;
@@ -163,7 +168,10 @@ pub fn run(a: BenchArgs) -> Result<()> {
             .collect::<Vec<_>>())
     })?;
     results.push((
-        format!("fast OADEV (stride m/{FAST_OVERLAP}), 6 ch, {} taus (sums only)", ms.len()),
+        format!(
+            "fast OADEV (stride m/{FAST_OVERLAP}), 6 ch, {} taus (sums only)",
+            ms.len()
+        ),
         best,
         med,
         String::new(),
@@ -229,7 +237,11 @@ fn write_logger_csv(log: &ImuLog, path: &std::path::Path) -> Result<()> {
     writeln!(w, "time,{}", names.join(","))?;
     let t = log.time_s.as_deref().unwrap_or(&[]);
     for i in 0..log.len() {
-        write!(w, "{:.2}", t.get(i).copied().unwrap_or(i as f64 * log.tau0_s))?;
+        write!(
+            w,
+            "{:.2}",
+            t.get(i).copied().unwrap_or(i as f64 * log.tau0_s)
+        )?;
         for c in &log.channels {
             write!(w, ",{:.6e}", c.values[i])?;
         }

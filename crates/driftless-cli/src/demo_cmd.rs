@@ -143,12 +143,10 @@ pub fn run(a: DemoArgs) -> Result<()> {
         fast: false,
     };
     let fit_cfg = FitConfig {
-        quantization: false,
         white: true,
         bias_instability: true,
         rate_random_walk: true,
-        rate_ramp: false,
-        gauss_markov: false,
+        ..FitConfig::NONE
     };
     let out = analyse_log(&log, &cfg, Some(&fit_cfg), None)?;
     let t_allan = t0.elapsed();

@@ -149,6 +149,48 @@ fn check_file(case: &Case, result_file: &str, tau0: f64) -> (usize, f64, f64) {
             );
         }
     }
+    // Automatic noise identification against Stable32's Alpha column: identical wherever
+    // the lag-1 ACF method applies (≥ 30 averaged points, Riley & Greenhall 2004); below
+    // that both tools fall back to the B1 ratio and may disagree — counted, not asserted.
+    let cfg = AnalysisConfig {
+        estimator: est,
+        taus: TauSpec::List(rows.iter().map(|r| r.m as f64 * tau0).collect()),
+        data_type: case.data_type,
+        alpha: None,
+        confidence: 0.683,
+        fast: false,
+    };
+    let auto = analyse("x", &data, tau0, &cfg).unwrap();
+    let n_phase = match case.data_type {
+        DataType::Phase => data.len(),
+        DataType::Frequency => data.len() + 1,
+    };
+    let (mut acf_rows, mut acf_agree, mut b1_rows, mut b1_agree) = (0, 0, 0, 0);
+    for r in &rows {
+        let Some(i) = auto.points.iter().position(|p| p.m == r.m) else {
+            panic!("{result_file}: m={} missing", r.m)
+        };
+        let same = usize::from(auto.alpha[i] == r.alpha);
+        if (n_phase - 1) / r.m >= 30 {
+            acf_rows += 1;
+            acf_agree += same;
+            // Files with confidence bounds are the ones where Stable32's noise ID was used.
+            if r.lo > 0.0 {
+                assert_eq!(
+                    auto.alpha[i], r.alpha,
+                    "{result_file} m={}: identified alpha {} vs Stable32 {}",
+                    r.m, auto.alpha[i], r.alpha
+                );
+            }
+        } else {
+            b1_rows += 1;
+            b1_agree += same;
+        }
+    }
+    eprintln!(
+        "{}/{result_file}: noise ID = Stable32 on {acf_agree}/{acf_rows} ACF-regime rows, {b1_agree}/{b1_rows} B1-regime rows",
+        case.folder
+    );
     eprintln!(
         "{}/{result_file}: {} rows, worst dev rel {worst_dev:.2e}, worst bound rel {worst_ci:.2e}",
         case.folder,

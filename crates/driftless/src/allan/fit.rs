@@ -71,6 +71,44 @@ pub struct FitConfig {
     pub gauss_markov: bool,
 }
 
+impl FitConfig {
+    /// Every term switched off (a starting point for building a selection).
+    pub const NONE: FitConfig = FitConfig {
+        quantization: false,
+        white: false,
+        bias_instability: false,
+        rate_random_walk: false,
+        rate_ramp: false,
+        gauss_markov: false,
+    };
+}
+
+/// Parses a comma-separated term list: `q` quantization, `n` white noise, `b` bias
+/// instability, `k` rate random walk, `r` rate ramp, `gm` one Gauss-Markov term.
+impl std::str::FromStr for FitConfig {
+    type Err = AllanError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let mut c = FitConfig::NONE;
+        for t in s.split(',').map(|t| t.trim().to_ascii_lowercase()) {
+            match t.as_str() {
+                "q" => c.quantization = true,
+                "n" => c.white = true,
+                "b" => c.bias_instability = true,
+                "k" => c.rate_random_walk = true,
+                "r" => c.rate_ramp = true,
+                "gm" => c.gauss_markov = true,
+                "" => {}
+                other => {
+                    return Err(AllanError::Invalid(format!(
+                        "unknown noise term {other:?} in {s:?} (expected q, n, b, k, r, gm)"
+                    )));
+                }
+            }
+        }
+        Ok(c)
+    }
+}
+
 impl Default for FitConfig {
     fn default() -> Self {
         FitConfig {
@@ -1108,15 +1146,11 @@ mod tests {
         let t = taus(10, 1.0, 10.0);
         assert!(fit_noise(&t, &t, &t, &cfg, 1.5).is_err());
         assert!(fit_noise(&t[..4], &t[..4], &t[..4], &cfg, 0.68).is_err());
-        let none = FitConfig {
-            quantization: false,
-            white: false,
-            bias_instability: false,
-            rate_random_walk: false,
-            rate_ramp: false,
-            gauss_markov: false,
-        };
-        assert!(fit_noise(&t, &t, &t, &none, 0.68).is_err());
+        assert!(fit_noise(&t, &t, &t, &FitConfig::NONE, 0.68).is_err());
+        let parsed: FitConfig = "n, b,K".parse().unwrap();
+        assert!(parsed.white && parsed.bias_instability && parsed.rate_random_walk);
+        assert!(!parsed.quantization && !parsed.rate_ramp && !parsed.gauss_markov);
+        assert!("n,x".parse::<FitConfig>().is_err());
     }
 
     #[test]

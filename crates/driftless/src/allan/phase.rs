@@ -98,7 +98,9 @@ mod tests {
     #[test]
     fn lanes_match_a_plain_compensated_sum() {
         // Compare with a single-chain Kahan sum on an awkward length.
-        let y: Vec<f64> = (0..10_007).map(|i| ((i * 7919) % 1013) as f64 * 1e-3 + 9.81).collect();
+        let y: Vec<f64> = (0..10_007)
+            .map(|i| ((i * 7919) % 1013) as f64 * 1e-3 + 9.81)
+            .collect();
         let x = frequency_to_phase(&y, 0.01);
         let mean = mean_f64(&y);
         let (mut s, mut c) = (0.0f64, 0.0f64);
