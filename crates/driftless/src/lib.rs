@@ -11,5 +11,6 @@
 
 pub mod allan;
 pub mod io;
+pub mod nav;
 pub mod report;
 pub mod sim;

@@ -1,0 +1,7 @@
+//! Navigation: Earth model, attitude conventions, strapdown mechanization and (next) the
+//! GNSS/INS error-state Kalman filter and smoother.
+//!
+//! Frames: navigation = local NED, body = forward-right-down, Earth = WGS-84. SI inside.
+
+pub mod attitude;
+pub mod earth;
