@@ -293,8 +293,8 @@ mod tests {
         let v = [1.0, 2.0, 3.0];
         let qv = q.mul(&Quat([0.0, v[0], v[1], v[2]])).mul(&q.conj());
         let dv = q.rotate(v);
-        for k in 0..3 {
-            assert!((qv.0[k + 1] - dv[k]).abs() < 1e-14);
+        for (k, d) in dv.iter().enumerate() {
+            assert!((qv.0[k + 1] - d).abs() < 1e-14);
         }
     }
 
