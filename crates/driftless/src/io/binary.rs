@@ -66,12 +66,7 @@ struct ChannelHeader {
 
 /// Writes `log` as a binary log to a file.
 pub fn write_binary_file(log: &ImuLog, path: impl AsRef<Path>) -> Result<(), LogError> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let file = std::fs::File::create(path).map_err(|error| LogError::Io {
-        path: name.clone(),
-        error,
-    })?;
+    let (file, name) = super::error::create_file(path.as_ref())?;
     write_impl(log, file, &name)
 }
 
@@ -193,14 +188,7 @@ fn write_impl<W: Write>(log: &ImuLog, mut w: W, dest: &str) -> Result<(), LogErr
 /// Reads a binary log from a file. The file size is checked against the header before any
 /// data is read.
 pub fn read_binary_file(path: impl AsRef<Path>) -> Result<ImuLog, LogError> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let io = |error| LogError::Io {
-        path: name.clone(),
-        error,
-    };
-    let file = std::fs::File::open(path).map_err(io)?;
-    let size = file.metadata().map_err(io)?.len();
+    let (file, size, name) = super::error::open_file(path.as_ref())?;
     read_impl(&file, &name, Some(size), Some(&file))
 }
 

@@ -376,3 +376,25 @@ pub fn sig6(v: f64) -> String {
         s
     }
 }
+
+/// Opens `path` for reading: (file, its size in bytes, display name); errors name the file.
+pub(crate) fn open_file(path: &std::path::Path) -> Result<(std::fs::File, u64, String), LogError> {
+    let name = path.display().to_string();
+    let io = |error| LogError::Io {
+        path: name.clone(),
+        error,
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let size = file.metadata().map_err(io)?.len();
+    Ok((file, size, name))
+}
+
+/// Creates (truncates) `path` for writing: (file, display name); errors name the file.
+pub(crate) fn create_file(path: &std::path::Path) -> Result<(std::fs::File, String), LogError> {
+    let name = path.display().to_string();
+    let file = std::fs::File::create(path).map_err(|error| LogError::Io {
+        path: name.clone(),
+        error,
+    })?;
+    Ok((file, name))
+}

@@ -290,14 +290,7 @@ impl FromStr for Delimiter {
 
 /// Reads a delimited text log from a file (streamed, never loaded whole).
 pub fn read_text_file(path: impl AsRef<Path>, opts: &TextOptions) -> Result<ImuLog, LogError> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let io = |error| LogError::Io {
-        path: name.clone(),
-        error,
-    };
-    let file = std::fs::File::open(path).map_err(io)?;
-    let size = file.metadata().map_err(io)?.len();
+    let (file, size, name) = super::error::open_file(path.as_ref())?;
     read_impl(file, &name, opts, Some(size))
 }
 

@@ -16,12 +16,7 @@ use super::log::ImuLog;
 
 /// Writes `log` as CSV to a file.
 pub fn write_csv_file(log: &ImuLog, path: impl AsRef<Path>) -> Result<(), LogError> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let file = std::fs::File::create(path).map_err(|error| LogError::Io {
-        path: name.clone(),
-        error,
-    })?;
+    let (file, name) = super::error::create_file(path.as_ref())?;
     write_impl(log, file, &name)
 }
 
