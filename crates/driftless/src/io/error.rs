@@ -304,6 +304,26 @@ pub enum LogError {
         /// What is wrong.
         message: String,
     },
+    /// A value that parses but is not acceptable: out of range, of the wrong YAML type or
+    /// length, in an apparently wrong unit, a GNSS σ ≤ 0, … (navigation formats).
+    #[error("{at}: {message}")]
+    InvalidValue {
+        /// Where.
+        at: Location,
+        /// What is wrong and what was expected.
+        message: String,
+    },
+    /// A file in a fixed third-party format (KF-GINS YAML, RTKLIB `.pos` / `.tag`, …) whose
+    /// structure is wrong or unsupported.
+    #[error("{at}: malformed {format}: {message}")]
+    Malformed {
+        /// Where.
+        at: Location,
+        /// The format's name.
+        format: &'static str,
+        /// What is wrong.
+        message: String,
+    },
     /// Writer: the log itself is inconsistent (channel lengths differ, …).
     #[error("{at}: cannot write log: {message}")]
     InvalidLog {
@@ -340,7 +360,9 @@ impl LogError {
             | CountMismatch { at, .. }
             | NonFiniteStored { at, .. }
             | Corrupt { at, .. }
-            | InvalidLog { at, .. } => Some(at),
+            | InvalidLog { at, .. }
+            | InvalidValue { at, .. }
+            | Malformed { at, .. } => Some(at),
         }
     }
 

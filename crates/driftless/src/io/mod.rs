@@ -12,6 +12,7 @@
 pub mod binary;
 pub mod error;
 pub mod log;
+pub mod nav;
 mod number;
 pub mod text;
 pub mod units;

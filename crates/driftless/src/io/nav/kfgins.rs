@@ -1,0 +1,803 @@
+//! KF-GINS text formats (i2Nav-WHU/KF-GINS, GPL-3.0). Formats learnt from its README
+//! ("2.2 Data format"), `src/fileio/{fileloader.cc,imufileloader.h,gnssfileloader.h,
+//! filesaver.cc}` and `src/kf_gins.cpp`; no code taken.
+//!
+//! **Input files.** One epoch per line; fields separated by any run of spaces, tabs or
+//! commas (KF-GINS splits on `", \t"` and skips empty pieces). No header, no comments.
+//! KF-GINS feeds every field to `strtod` without checks; here every field must be a finite
+//! number, every row must have as many fields as the first, and time must strictly
+//! increase — otherwise one [`LogError`] names the file, line and column. Blank lines are
+//! skipped (KF-GINS stops reading at the first blank line).
+//!
+//! * IMU (`imupath`): `time [GPS s of week], dθx, dθy, dθz [rad], dvx, dvy, dvz [m/s]`,
+//!   increments over the interval ending at `time`, body frame forward-right-down. KF-GINS
+//!   reads `imudatalen` ≥ 7 columns and uses the first 7 (an 8th is an odometer speed,
+//!   m/s); extra columns are accepted and ignored here too.
+//! * GNSS (`gnsspath`): 7 columns `time [s], lat [deg], lon [deg], h [m], σN, σE, σD [m]`,
+//!   or 13 columns, which KF-GINS's loader reads as `time, lat, lon, h, vN, vE, vD [m/s],
+//!   σN, σE, σD [m], σvN, σvE, σvD [m/s]` (it takes σ from columns 8–10 of a 13-column file;
+//!   the velocity meaning of columns 5–7 and 11–13 follows its comment "13-column GNSS
+//!   files contain GNSS velocity").
+//!
+//! **Output files** (written by `kf_gins.cpp` into `outputpath`): every value printed with
+//! C's `"%-15.9lf "` (left-aligned, width 15, 9 decimals, one space after), lines ending
+//! in `\n`:
+//! * `KF_GINS_Navresult.nav`: `week, time [s], lat [deg], lon [deg], h [m], vN, vE, vD
+//!   [m/s], roll, pitch, yaw [deg]` — KF-GINS always writes 0 as the week.
+//! * `KF_GINS_IMU_ERR.txt`: `time, gyro bias xyz [deg/h], accel bias xyz [mGal], gyro
+//!   scale xyz [ppm], accel scale xyz [ppm]`.
+//! * `KF_GINS_STD.txt`: `time, pos NED [m], vel NED [m/s], att [deg], gyro bias [deg/h],
+//!   accel bias [mGal], gyro scale [ppm], accel scale [ppm]` (22 columns).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use super::types::{GnssFixes, ImuErrors, ImuIncrements, NavSolution, NavStd, common_len};
+use super::{Field, as_utf8, check_time_order, parse_num, read_file, split_fields};
+use crate::io::{Location, LogError};
+
+/// Field separators of KF-GINS's text loader.
+const SEPS: &[u8] = b", \t\r";
+
+/// Degrees per radian.
+const R2D: f64 = 180.0 / std::f64::consts::PI;
+/// 1 mGal = 1e-5 m/s².
+const MGAL_PER_M_S2: f64 = 1e5;
+/// 1 ppm = 1e-6.
+const PPM: f64 = 1e6;
+
+/// File names KF-GINS writes into `outputpath`.
+pub const NAV_FILE: &str = "KF_GINS_Navresult.nav";
+/// IMU-error file name.
+pub const IMU_ERR_FILE: &str = "KF_GINS_IMU_ERR.txt";
+/// State-std file name.
+pub const STD_FILE: &str = "KF_GINS_STD.txt";
+
+/// What a GNSS reader does with a standard deviation of zero.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum ZeroSigma {
+    /// σ = 0 is an error naming the field (default): a zero σ makes a measurement
+    /// infinitely trusted, which a Kalman filter cannot digest.
+    #[default]
+    Error,
+    /// Replace σ below the floor (zero included) by the floor; negative σ is still an error.
+    Floor {
+        /// Floor for position σ, m (must be > 0).
+        pos_m: f64,
+        /// Floor for velocity σ, m/s (must be > 0).
+        vel_m_s: f64,
+    },
+}
+
+/// Options of the GNSS readers (KF-GINS and RTKLIB).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct GnssReadOptions {
+    /// Handling of σ = 0.
+    pub zero_sigma: ZeroSigma,
+}
+
+/// Applies the σ policy to one σ value.
+pub(crate) fn check_sigma(
+    v: f64,
+    vel: bool,
+    opts: &GnssReadOptions,
+    at: Location,
+    name: &str,
+) -> Result<f64, LogError> {
+    if v < 0.0 {
+        return Err(LogError::InvalidValue {
+            at,
+            message: format!("negative standard deviation {v} in column {name}"),
+        });
+    }
+    match opts.zero_sigma {
+        ZeroSigma::Error if v == 0.0 => Err(LogError::InvalidValue {
+            at,
+            message: format!(
+                "standard deviation 0 in column {name}: a zero σ would make the fix infinitely trusted; set a σ floor (ZeroSigma::Floor) to accept it"
+            ),
+        }),
+        ZeroSigma::Error => Ok(v),
+        ZeroSigma::Floor { pos_m, vel_m_s } => {
+            let floor = if vel { vel_m_s } else { pos_m };
+            if !(floor > 0.0 && floor.is_finite()) {
+                return Err(LogError::InvalidOptions {
+                    at: Location::input(&at.path),
+                    message: format!("σ floor must be finite and > 0, got {floor}"),
+                });
+            }
+            Ok(v.max(floor))
+        }
+    }
+}
+
+/// Checks latitude and longitude ranges (degrees) of one epoch.
+pub(crate) fn check_lat_lon(
+    lat_deg: f64,
+    lon_deg: f64,
+    path: &str,
+    line: usize,
+    lat_f: Field<'_>,
+    lon_f: Field<'_>,
+) -> Result<(), LogError> {
+    if !(-90.0..=90.0).contains(&lat_deg) {
+        return Err(LogError::InvalidValue {
+            at: Location::field(path, line, lat_f.col),
+            message: format!("latitude {lat_deg} deg outside [-90, 90]"),
+        });
+    }
+    if !(-360.0..=360.0).contains(&lon_deg) {
+        return Err(LogError::InvalidValue {
+            at: Location::field(path, line, lon_f.col),
+            message: format!("longitude {lon_deg} deg outside [-360, 360]"),
+        });
+    }
+    Ok(())
+}
+
+/// Data lines of a text input: (1-based line number, line text), blank lines skipped.
+fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)))
+        .filter(|(_, l)| !l.trim().is_empty())
+}
+
+/// Checks the field count of a row against the first row's.
+fn check_count(
+    fields: &[Field<'_>],
+    line_text: &str,
+    expected: usize,
+    reference_line: usize,
+    path: &str,
+    line: usize,
+) -> Result<(), LogError> {
+    if fields.len() != expected {
+        let col = fields.get(expected).map_or(line_text.len() + 1, |f| f.col);
+        return Err(LogError::Ragged {
+            at: Location::field(path, line, col),
+            found: fields.len(),
+            expected,
+            reference_line,
+        });
+    }
+    Ok(())
+}
+
+const IMU_NAMES: [&str; 7] = [
+    "time_s",
+    "dtheta_x_rad",
+    "dtheta_y_rad",
+    "dtheta_z_rad",
+    "dvel_x_m_s",
+    "dvel_y_m_s",
+    "dvel_z_m_s",
+];
+
+/// Reads a KF-GINS IMU text file (see the module docs for the format).
+pub fn read_kfgins_imu_file(path: impl AsRef<Path>) -> Result<ImuIncrements, LogError> {
+    let path = path.as_ref();
+    read_kfgins_imu(&read_file(path)?, &path.display().to_string())
+}
+
+/// Reads KF-GINS IMU text from memory; `name` is used in error messages.
+pub fn read_kfgins_imu(bytes: &[u8], name: &str) -> Result<ImuIncrements, LogError> {
+    let text = as_utf8(bytes, name)?;
+    let mut out = ImuIncrements::default();
+    let mut reference: Option<(usize, usize)> = None;
+    let mut prev: Option<f64> = None;
+    for (line, l) in data_lines(text) {
+        let fields = split_fields(l, SEPS);
+        let (expected, ref_line) = *reference.get_or_insert((fields.len(), line));
+        if expected < 7 {
+            let col = l.len() + 1;
+            return Err(LogError::Ragged {
+                at: Location::field(name, line, col),
+                found: fields.len(),
+                expected: 7,
+                reference_line: line,
+            });
+        }
+        check_count(&fields, l, expected, ref_line, name, line)?;
+        let mut v = [0.0; 7];
+        for (k, slot) in v.iter_mut().enumerate() {
+            *slot = parse_num(fields[k], name, line, k + 1, IMU_NAMES[k])?;
+        }
+        // Extra columns (odometer, …) must still be numbers, as KF-GINS reads them.
+        for (k, f) in fields.iter().enumerate().skip(7) {
+            parse_num(*f, name, line, k + 1, "extra")?;
+        }
+        check_time_order(v[0], prev, name, line, 1, IMU_NAMES[0])?;
+        prev = Some(v[0]);
+        out.time_s.push(v[0]);
+        out.dtheta_rad.push([v[1], v[2], v[3]]);
+        out.dvel_m_s.push([v[4], v[5], v[6]]);
+    }
+    if out.is_empty() {
+        return Err(LogError::Empty {
+            at: Location::input(name),
+        });
+    }
+    Ok(out)
+}
+
+const GNSS_NAMES_7: [&str; 7] = [
+    "time_s",
+    "lat_deg",
+    "lon_deg",
+    "height_m",
+    "sigma_n_m",
+    "sigma_e_m",
+    "sigma_d_m",
+];
+const GNSS_NAMES_13: [&str; 13] = [
+    "time_s",
+    "lat_deg",
+    "lon_deg",
+    "height_m",
+    "vel_n_m_s",
+    "vel_e_m_s",
+    "vel_d_m_s",
+    "sigma_n_m",
+    "sigma_e_m",
+    "sigma_d_m",
+    "sigma_vel_n_m_s",
+    "sigma_vel_e_m_s",
+    "sigma_vel_d_m_s",
+];
+
+/// Reads a KF-GINS GNSS text file (7 or 13 columns, see the module docs).
+pub fn read_kfgins_gnss_file(
+    path: impl AsRef<Path>,
+    opts: &GnssReadOptions,
+) -> Result<GnssFixes, LogError> {
+    let path = path.as_ref();
+    read_kfgins_gnss(&read_file(path)?, &path.display().to_string(), opts)
+}
+
+/// Reads KF-GINS GNSS text from memory; `name` is used in error messages. Quality flags
+/// are [`super::quality::UNSPECIFIED`]; `gps_week` and `n_sats` are `None`.
+pub fn read_kfgins_gnss(
+    bytes: &[u8],
+    name: &str,
+    opts: &GnssReadOptions,
+) -> Result<GnssFixes, LogError> {
+    let text = as_utf8(bytes, name)?;
+    let mut out = GnssFixes::default();
+    let mut vel = Vec::new();
+    let mut svel = Vec::new();
+    let mut reference: Option<(usize, usize)> = None;
+    let mut prev: Option<f64> = None;
+    for (line, l) in data_lines(text) {
+        let fields = split_fields(l, SEPS);
+        let (expected, ref_line) = *reference.get_or_insert((fields.len(), line));
+        if expected != 7 && expected != 13 {
+            let col = fields.get(7).map_or(l.len() + 1, |f| f.col);
+            return Err(LogError::Ragged {
+                at: Location::field(name, line, col),
+                found: fields.len(),
+                expected: if expected < 7 { 7 } else { 13 },
+                reference_line: line,
+            });
+        }
+        check_count(&fields, l, expected, ref_line, name, line)?;
+        let names: &[&str] = if expected == 7 {
+            &GNSS_NAMES_7
+        } else {
+            &GNSS_NAMES_13
+        };
+        let mut v = [0.0; 13];
+        for k in 0..expected {
+            v[k] = parse_num(fields[k], name, line, k + 1, names[k])?;
+        }
+        check_time_order(v[0], prev, name, line, 1, names[0])?;
+        prev = Some(v[0]);
+        check_lat_lon(v[1], v[2], name, line, fields[1], fields[2])?;
+        let s0 = if expected == 7 { 4 } else { 7 };
+        let mut sig = [0.0; 3];
+        for (i, slot) in sig.iter_mut().enumerate() {
+            let k = s0 + i;
+            *slot = check_sigma(
+                v[k],
+                false,
+                opts,
+                Location::field(name, line, fields[k].col),
+                names[k],
+            )?;
+        }
+        if expected == 13 {
+            let mut sv = [0.0; 3];
+            for (i, slot) in sv.iter_mut().enumerate() {
+                let k = 10 + i;
+                *slot = check_sigma(
+                    v[k],
+                    true,
+                    opts,
+                    Location::field(name, line, fields[k].col),
+                    names[k],
+                )?;
+            }
+            vel.push([v[4], v[5], v[6]]);
+            svel.push(sv);
+        }
+        out.time_s.push(v[0]);
+        out.lat_rad.push(v[1].to_radians());
+        out.lon_rad.push(v[2].to_radians());
+        out.height_m.push(v[3]);
+        out.sigma_ned_m.push(sig);
+        out.quality.push(super::quality::UNSPECIFIED);
+    }
+    if out.is_empty() {
+        return Err(LogError::Empty {
+            at: Location::input(name),
+        });
+    }
+    if reference.is_some_and(|(n, _)| n == 13) {
+        out.vel_ned_m_s = Some(vel);
+        out.sigma_vel_ned_m_s = Some(svel);
+    }
+    Ok(out)
+}
+
+/// Appends one value in KF-GINS's `"%-15.9lf "` format.
+fn push_value(line: &mut String, v: f64) {
+    use std::fmt::Write as _;
+    let _ = write!(line, "{v:<15.9} ");
+}
+
+/// Writes rows of values after checking that every value is finite.
+fn write_rows(
+    mut w: impl Write,
+    name: &str,
+    n: usize,
+    mut row: impl FnMut(usize, &mut Vec<f64>),
+) -> Result<(), LogError> {
+    let io_err = |error| LogError::Io {
+        path: name.to_owned(),
+        error,
+    };
+    let mut vals = Vec::with_capacity(22);
+    let mut line = String::with_capacity(22 * 16 + 1);
+    for i in 0..n {
+        vals.clear();
+        row(i, &mut vals);
+        line.clear();
+        for (k, &v) in vals.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(LogError::InvalidLog {
+                    at: Location::input(name),
+                    message: format!("non-finite value {v} in row {i}, column {}", k + 1),
+                });
+            }
+            push_value(&mut line, v);
+        }
+        line.push('\n');
+        w.write_all(line.as_bytes()).map_err(io_err)?;
+    }
+    w.flush().map_err(io_err)
+}
+
+fn lens_err(name: &str, message: String) -> LogError {
+    LogError::InvalidLog {
+        at: Location::input(name),
+        message,
+    }
+}
+
+/// Writes a navigation solution in KF-GINS's `.nav` format (11 columns, see the module
+/// docs); `gps_week` goes into column 1 (KF-GINS itself always writes 0).
+pub fn write_kfgins_nav(
+    w: impl Write,
+    name: &str,
+    sol: &NavSolution,
+    gps_week: u16,
+) -> Result<(), LogError> {
+    let n = common_len(&[
+        ("time_s", sol.time_s.len()),
+        ("lat_rad", sol.lat_rad.len()),
+        ("lon_rad", sol.lon_rad.len()),
+        ("height_m", sol.height_m.len()),
+        ("vel_ned_m_s", sol.vel_ned_m_s.len()),
+        ("roll_pitch_yaw_rad", sol.roll_pitch_yaw_rad.len()),
+    ])
+    .map_err(|m| lens_err(name, m))?;
+    write_rows(w, name, n, |i, r| {
+        r.push(f64::from(gps_week));
+        r.push(sol.time_s[i]);
+        r.push(sol.lat_rad[i] * R2D);
+        r.push(sol.lon_rad[i] * R2D);
+        r.push(sol.height_m[i]);
+        r.extend_from_slice(&sol.vel_ned_m_s[i]);
+        r.extend(sol.roll_pitch_yaw_rad[i].iter().map(|a| a * R2D));
+    })
+}
+
+/// Writes estimated IMU errors in KF-GINS's `KF_GINS_IMU_ERR.txt` format (13 columns).
+pub fn write_kfgins_imu_err(w: impl Write, name: &str, e: &ImuErrors) -> Result<(), LogError> {
+    let n = common_len(&[
+        ("time_s", e.time_s.len()),
+        ("gyro_bias_rad_s", e.gyro_bias_rad_s.len()),
+        ("accel_bias_m_s2", e.accel_bias_m_s2.len()),
+        ("gyro_scale", e.gyro_scale.len()),
+        ("accel_scale", e.accel_scale.len()),
+    ])
+    .map_err(|m| lens_err(name, m))?;
+    write_rows(w, name, n, |i, r| {
+        r.push(e.time_s[i]);
+        r.extend(e.gyro_bias_rad_s[i].iter().map(|b| b * R2D * 3600.0));
+        r.extend(e.accel_bias_m_s2[i].iter().map(|b| b * MGAL_PER_M_S2));
+        r.extend(e.gyro_scale[i].iter().map(|s| s * PPM));
+        r.extend(e.accel_scale[i].iter().map(|s| s * PPM));
+    })
+}
+
+/// Writes state standard deviations in KF-GINS's `KF_GINS_STD.txt` format (22 columns).
+pub fn write_kfgins_std(w: impl Write, name: &str, s: &NavStd) -> Result<(), LogError> {
+    let n = common_len(&[
+        ("time_s", s.time_s.len()),
+        ("pos_ned_m", s.pos_ned_m.len()),
+        ("vel_ned_m_s", s.vel_ned_m_s.len()),
+        ("att_rad", s.att_rad.len()),
+        ("gyro_bias_rad_s", s.gyro_bias_rad_s.len()),
+        ("accel_bias_m_s2", s.accel_bias_m_s2.len()),
+        ("gyro_scale", s.gyro_scale.len()),
+        ("accel_scale", s.accel_scale.len()),
+    ])
+    .map_err(|m| lens_err(name, m))?;
+    write_rows(w, name, n, |i, r| {
+        r.push(s.time_s[i]);
+        r.extend_from_slice(&s.pos_ned_m[i]);
+        r.extend_from_slice(&s.vel_ned_m_s[i]);
+        r.extend(s.att_rad[i].iter().map(|a| a * R2D));
+        r.extend(s.gyro_bias_rad_s[i].iter().map(|b| b * R2D * 3600.0));
+        r.extend(s.accel_bias_m_s2[i].iter().map(|b| b * MGAL_PER_M_S2));
+        r.extend(s.gyro_scale[i].iter().map(|v| v * PPM));
+        r.extend(s.accel_scale[i].iter().map(|v| v * PPM));
+    })
+}
+
+/// Writes KF-GINS's three output files into `dir` (KF-GINS's `outputpath`, which must
+/// exist, as in KF-GINS) and returns their paths: `.nav`, IMU error, std.
+pub fn write_kfgins_outputs(
+    dir: impl AsRef<Path>,
+    sol: &NavSolution,
+    imu_err: &ImuErrors,
+    std: &NavStd,
+    gps_week: u16,
+) -> Result<[PathBuf; 3], LogError> {
+    let dir = dir.as_ref();
+    let paths = [
+        dir.join(NAV_FILE),
+        dir.join(IMU_ERR_FILE),
+        dir.join(STD_FILE),
+    ];
+    let create = |p: &Path| {
+        std::fs::File::create(p)
+            .map(std::io::BufWriter::new)
+            .map_err(|error| LogError::Io {
+                path: p.display().to_string(),
+                error,
+            })
+    };
+    let name = |p: &Path| p.display().to_string();
+    write_kfgins_nav(create(&paths[0])?, &name(&paths[0]), sol, gps_week)?;
+    write_kfgins_imu_err(create(&paths[1])?, &name(&paths[1]), imu_err)?;
+    write_kfgins_std(create(&paths[2])?, &name(&paths[2]), std)?;
+    Ok(paths)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const IMU: &str = "\
+456300.000 1.0e-5 -2.0e-5 3.0e-5 0.001 -0.002 0.049
+456300.005, 1.1e-5, -2.1e-5, 3.1e-5, 0.0011, -0.0021, 0.0491
+\t456300.010\t1.2e-5\t-2.2e-5\t3.2e-5\t0.0012\t-0.0022\t0.0492\r
+";
+
+    #[test]
+    fn imu_reads_all_separators() {
+        let imu = read_kfgins_imu(IMU.as_bytes(), "imu.txt").unwrap();
+        assert_eq!(imu.len(), 3);
+        assert_eq!(imu.time_s, vec![456300.0, 456300.005, 456300.010]);
+        assert_eq!(imu.dtheta_rad[1], [1.1e-5, -2.1e-5, 3.1e-5]);
+        assert_eq!(imu.dvel_m_s[2], [0.0012, -0.0022, 0.0492]);
+    }
+
+    #[test]
+    fn imu_eight_columns_ok_but_ragged_rejected() {
+        let ok = "1 0 0 0 0 0 0 5.0\n2 0 0 0 0 0 0 5.1\n";
+        assert_eq!(read_kfgins_imu(ok.as_bytes(), "i").unwrap().len(), 2);
+        let extra = "1 0 0 0 0 0 0\n2 0 0 0 0 0 0 9\n";
+        let e = read_kfgins_imu(extra.as_bytes(), "i").unwrap_err();
+        assert!(
+            matches!(
+                e,
+                LogError::Ragged {
+                    found: 8,
+                    expected: 7,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "i:2:15: row has 8 fields, expected 7 (as on line 1)"
+        );
+        let missing = "1 0 0 0 0 0 0\n2 0 0 0 0 0\n";
+        let e = read_kfgins_imu(missing.as_bytes(), "i").unwrap_err();
+        assert!(matches!(e, LogError::Ragged { found: 6, .. }), "{e}");
+        assert_eq!(e.line(), Some(2));
+        let short = "1 0 0 0 0 0\n";
+        assert!(matches!(
+            read_kfgins_imu(short.as_bytes(), "i").unwrap_err(),
+            LogError::Ragged {
+                found: 6,
+                expected: 7,
+                ..
+            }
+        ));
+    }
+
+    #[test]
+    fn imu_non_numeric_and_non_finite() {
+        let bad = "1 0 0 0 0 0 0\n2 0 abc 0 0 0 0\n";
+        let e = read_kfgins_imu(bad.as_bytes(), "imu.txt").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "imu.txt:2:5: non-numeric value \"abc\" in column 3 (dtheta_y_rad)"
+        );
+        let nan = "1 0 0 0 0 0 nan\n";
+        assert!(matches!(
+            read_kfgins_imu(nan.as_bytes(), "i").unwrap_err(),
+            LogError::NonFinite { field: 7, .. }
+        ));
+        assert!(matches!(
+            read_kfgins_imu(b"\n\n", "i").unwrap_err(),
+            LogError::Empty { .. }
+        ));
+    }
+
+    #[test]
+    fn imu_time_order() {
+        let dup = "1 0 0 0 0 0 0\n1 0 0 0 0 0 0\n";
+        let e = read_kfgins_imu(dup.as_bytes(), "i").unwrap_err();
+        assert!(
+            matches!(e, LogError::DuplicateTime { time_s: 1.0, .. }),
+            "{e}"
+        );
+        assert_eq!(e.line(), Some(2));
+        let back = "1 0 0 0 0 0 0\n2 0 0 0 0 0 0\n\n1.5 0 0 0 0 0 0\n";
+        let e = read_kfgins_imu(back.as_bytes(), "i").unwrap_err();
+        assert!(matches!(e, LogError::NonMonotonicTime { .. }), "{e}");
+        assert_eq!(e.line(), Some(4));
+    }
+
+    const GNSS7: &str = "\
+456250.000    30.4447858054   114.4718661162     21.095    0.010    0.009    0.019
+456251.000    30.4447857891   114.4718661133     21.091    0.011    0.008    0.020
+";
+
+    #[test]
+    fn gnss_seven_columns() {
+        let g = read_kfgins_gnss(GNSS7.as_bytes(), "g", &GnssReadOptions::default()).unwrap();
+        assert_eq!(g.len(), 2);
+        assert!((g.lat_rad[0] - 30.4447858054f64.to_radians()).abs() < 1e-15);
+        assert!((g.lon_rad[1] - 114.4718661133f64.to_radians()).abs() < 1e-15);
+        assert_eq!(g.height_m, vec![21.095, 21.091]);
+        assert_eq!(g.sigma_ned_m[1], [0.011, 0.008, 0.020]);
+        assert!(g.vel_ned_m_s.is_none() && g.n_sats.is_none() && g.gps_week.is_none());
+        assert_eq!(g.quality, vec![0, 0]);
+    }
+
+    #[test]
+    fn gnss_thirteen_columns() {
+        let t = "10 30 114 20 1.0 -2.0 0.5 0.01 0.02 0.03 0.1 0.2 0.3\n\
+                 11 30 114 20 1.1 -2.1 0.6 0.01 0.02 0.03 0.1 0.2 0.3\n";
+        let g = read_kfgins_gnss(t.as_bytes(), "g", &GnssReadOptions::default()).unwrap();
+        assert_eq!(g.vel_ned_m_s.as_ref().unwrap()[1], [1.1, -2.1, 0.6]);
+        assert_eq!(g.sigma_ned_m[0], [0.01, 0.02, 0.03]);
+        assert_eq!(g.sigma_vel_ned_m_s.as_ref().unwrap()[0], [0.1, 0.2, 0.3]);
+        // 8 columns: neither format.
+        let e = read_kfgins_gnss(b"1 30 114 20 1 1 1 1\n", "g", &GnssReadOptions::default())
+            .unwrap_err();
+        assert!(matches!(e, LogError::Ragged { found: 8, .. }), "{e}");
+        // A missing column on line 2.
+        let t = "1 30 114 20 1 1 1\n2 30 114 20 1 1\n";
+        let e = read_kfgins_gnss(t.as_bytes(), "g", &GnssReadOptions::default()).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                LogError::Ragged {
+                    found: 6,
+                    expected: 7,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn gnss_sigma_zero_and_ranges() {
+        let t = "1 30 114 20 0.01 0 0.02\n";
+        let e = read_kfgins_gnss(t.as_bytes(), "g.txt", &GnssReadOptions::default()).unwrap_err();
+        assert!(matches!(e, LogError::InvalidValue { .. }), "{e}");
+        assert!(
+            e.to_string()
+                .starts_with("g.txt:1:18: standard deviation 0"),
+            "{e}"
+        );
+        let floor = GnssReadOptions {
+            zero_sigma: ZeroSigma::Floor {
+                pos_m: 0.005,
+                vel_m_s: 0.01,
+            },
+        };
+        let g = read_kfgins_gnss(t.as_bytes(), "g", &floor).unwrap();
+        assert_eq!(g.sigma_ned_m[0], [0.01, 0.005, 0.02]);
+        let neg = "1 30 114 20 0.01 -0.1 0.02\n";
+        assert!(read_kfgins_gnss(neg.as_bytes(), "g", &floor).is_err());
+        let lat = "1 95 114 20 0.01 0.01 0.02\n";
+        let e = read_kfgins_gnss(lat.as_bytes(), "g", &floor).unwrap_err();
+        assert_eq!(e.to_string(), "g:1:3: latitude 95 deg outside [-90, 90]");
+        let dup = "1 30 114 20 1 1 1\n1 30 114 20 1 1 1\n";
+        assert!(matches!(
+            read_kfgins_gnss(dup.as_bytes(), "g", &floor).unwrap_err(),
+            LogError::DuplicateTime { .. }
+        ));
+    }
+
+    fn nav_fixture() -> NavSolution {
+        NavSolution {
+            time_s: vec![456300.005, 456300.010],
+            lat_rad: vec![30.5f64.to_radians(), 30.25f64.to_radians()],
+            lon_rad: vec![114.5f64.to_radians(), -114.5f64.to_radians()],
+            height_m: vec![20.9, -3.5],
+            vel_ned_m_s: vec![[0.1, -0.2, 0.3], [0.0, 0.0, -0.0]],
+            roll_pitch_yaw_rad: vec![
+                [1f64.to_radians(), -2f64.to_radians(), 185f64.to_radians()],
+                [0.0, 0.0, -90f64.to_radians()],
+            ],
+        }
+    }
+
+    #[test]
+    fn nav_writer_matches_kfgins_layout() {
+        let mut out = Vec::new();
+        write_kfgins_nav(&mut out, "nav", &nav_fixture(), 0).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 2);
+        // Every field is padded to 15 characters and followed by one space; the time
+        // (16 digits) overflows its field as C's printf does: 11 × 16 + 1 characters.
+        assert_eq!(lines[0].len(), 11 * 16 + 1);
+        assert!(lines[0].starts_with("0.000000000     456300.005000000 30.500000000    "));
+        let f: Vec<f64> = lines[1]
+            .split_whitespace()
+            .map(|s| s.parse().unwrap())
+            .collect();
+        assert_eq!(f.len(), 11);
+        assert_eq!(f[2], 30.25);
+        assert_eq!(f[3], -114.5);
+        assert_eq!(f[4], -3.5);
+        assert!((f[10] + 90.0).abs() < 1e-9);
+        // Mismatched lengths and NaN are refused.
+        let mut bad = nav_fixture();
+        bad.height_m.pop();
+        assert!(matches!(
+            write_kfgins_nav(Vec::new(), "nav", &bad, 0).unwrap_err(),
+            LogError::InvalidLog { .. }
+        ));
+        let mut bad = nav_fixture();
+        bad.height_m[1] = f64::NAN;
+        assert!(write_kfgins_nav(Vec::new(), "nav", &bad, 0).is_err());
+    }
+
+    #[test]
+    fn imu_err_and_std_writers_convert_units() {
+        let d2r = 1f64.to_radians();
+        let e = ImuErrors {
+            time_s: vec![10.0],
+            gyro_bias_rad_s: vec![[d2r / 3600.0, 2.0 * d2r / 3600.0, 0.0]],
+            accel_bias_m_s2: vec![[1e-5, 0.0, -5e-4]],
+            gyro_scale: vec![[1e-6, 0.0, 0.0]],
+            accel_scale: vec![[0.0, -3e-4, 0.0]],
+        };
+        let mut out = Vec::new();
+        write_kfgins_imu_err(&mut out, "e", &e).unwrap();
+        let f: Vec<f64> = String::from_utf8(out)
+            .unwrap()
+            .split_whitespace()
+            .map(|s| s.parse().unwrap())
+            .collect();
+        let want = [
+            10.0, 1.0, 2.0, 0.0, 1.0, 0.0, -50.0, 1.0, 0.0, 0.0, 0.0, -300.0, 0.0,
+        ];
+        assert_eq!(f.len(), 13);
+        for (a, b) in f.iter().zip(want) {
+            assert!((a - b).abs() < 1e-8, "{f:?}");
+        }
+        let s = NavStd {
+            time_s: vec![10.0],
+            pos_ned_m: vec![[0.1, 0.2, 0.3]],
+            vel_ned_m_s: vec![[0.01, 0.02, 0.03]],
+            att_rad: vec![[d2r, 0.0, 2.0 * d2r]],
+            gyro_bias_rad_s: vec![[d2r / 3600.0; 3]],
+            accel_bias_m_s2: vec![[1e-5; 3]],
+            gyro_scale: vec![[1e-6; 3]],
+            accel_scale: vec![[2e-6; 3]],
+        };
+        let mut out = Vec::new();
+        write_kfgins_std(&mut out, "s", &s).unwrap();
+        let f: Vec<f64> = String::from_utf8(out)
+            .unwrap()
+            .split_whitespace()
+            .map(|s| s.parse().unwrap())
+            .collect();
+        assert_eq!(f.len(), 22);
+        assert!((f[7] - 1.0).abs() < 1e-9 && (f[9] - 2.0).abs() < 1e-9);
+        assert!((f[10] - 1.0).abs() < 1e-9 && (f[13] - 1.0).abs() < 1e-9);
+        assert!((f[16] - 1.0).abs() < 1e-9 && (f[21] - 2.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn outputs_round_trip_through_the_reader_layouts() {
+        let dir = std::env::temp_dir().join(format!("driftless-navio-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let sol = nav_fixture();
+        let e = ImuErrors {
+            time_s: sol.time_s.clone(),
+            gyro_bias_rad_s: vec![[0.0; 3]; 2],
+            accel_bias_m_s2: vec![[0.0; 3]; 2],
+            gyro_scale: vec![[0.0; 3]; 2],
+            accel_scale: vec![[0.0; 3]; 2],
+        };
+        let s = NavStd {
+            time_s: sol.time_s.clone(),
+            pos_ned_m: vec![[1.0; 3]; 2],
+            vel_ned_m_s: vec![[1.0; 3]; 2],
+            att_rad: vec![[1.0; 3]; 2],
+            gyro_bias_rad_s: vec![[1.0; 3]; 2],
+            accel_bias_m_s2: vec![[1.0; 3]; 2],
+            gyro_scale: vec![[1.0; 3]; 2],
+            accel_scale: vec![[1.0; 3]; 2],
+        };
+        let paths = write_kfgins_outputs(&dir, &sol, &e, &s, 2374).unwrap();
+        assert!(paths[0].ends_with("KF_GINS_Navresult.nav"));
+        assert!(paths[1].ends_with("KF_GINS_IMU_ERR.txt"));
+        assert!(paths[2].ends_with("KF_GINS_STD.txt"));
+        let nav = std::fs::read_to_string(&paths[0]).unwrap();
+        assert!(nav.starts_with("2374.000000000  456300.005000000"));
+        let cols: Vec<usize> = [&paths[1], &paths[2]]
+            .iter()
+            .map(|p| {
+                let t = std::fs::read_to_string(p).unwrap();
+                t.lines().next().unwrap().split_whitespace().count()
+            })
+            .collect();
+        assert_eq!(cols, vec![13, 22]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    #[ignore = "needs shared data"]
+    fn wuhan_kfgins_gnss_file() {
+        let dir = std::env::var("DRIFTLESS_DATA").map_or_else(
+            |_| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
+            PathBuf::from,
+        );
+        let g = read_kfgins_gnss_file(
+            dir.join("trajectories/kfgins_wuhan_gnss_rtk_1hz.txt"),
+            &GnssReadOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(g.len(), 3413);
+        assert_eq!(g.time_s[0], 456_250.0);
+        assert_eq!(g.sigma_ned_m[0], [0.010, 0.009, 0.019]);
+        assert!((g.lat_rad[0].to_degrees() - 30.4447858054).abs() < 1e-10);
+        assert!(g.vel_ned_m_s.is_none());
+    }
+}

@@ -1,0 +1,152 @@
+//! Navigation input/output formats: readers and writers only, no navigation math.
+//!
+//! Readers turn files into the typed, columnar records of [`types`] (SI units, names with
+//! units), converting units at this edge only; writers do the reverse. Every bad input gives
+//! one [`LogError`] naming the file, line and column; readers never return NaN and never
+//! return partial data.
+//!
+//! * [`kfgins`]: the text formats of KF-GINS (i2Nav-WHU/KF-GINS, GPL-3.0; formats learnt from
+//!   its README, `src/fileio/*` and `src/kf_gins.cpp`, no code taken): IMU increments,
+//!   GNSS positions, and the three output files (`KF_GINS_Navresult.nav`,
+//!   `KF_GINS_IMU_ERR.txt`, `KF_GINS_STD.txt`).
+//! * [`kfgins_config`]: KF-GINS's YAML configuration (`kf-gins.yaml`) → [`KfGinsConfig`].
+//! * [`rtklib`]: RTKLIB `.pos` solutions and binary `.tag` time-tag files, and the mapping of
+//!   a tick-stamped IMU CSV to GPS time.
+//! * [`gpstime`]: GPS time (GPST, no leap seconds) ↔ calendar and (week, seconds of week).
+//!
+//! OWNER: helper "navio".
+
+pub mod gpstime;
+pub mod kfgins;
+pub mod kfgins_config;
+pub mod rtklib;
+pub mod types;
+
+pub use gpstime::GpsTime;
+pub use kfgins::{
+    GnssReadOptions, ZeroSigma, read_kfgins_gnss, read_kfgins_gnss_file, read_kfgins_imu,
+    read_kfgins_imu_file, write_kfgins_imu_err, write_kfgins_nav, write_kfgins_outputs,
+    write_kfgins_std,
+};
+pub use kfgins_config::{ImuNoise, KfGinsConfig, KfGinsConfigRaw};
+pub use rtklib::{
+    FposSize, TaggedTimes, TickMapping, TimeTag, map_ticks_to_gps, read_rtklib_pos,
+    read_rtklib_pos_file, read_rtklib_tag, read_rtklib_tag_file,
+};
+pub use types::{GnssFixes, ImuErrors, ImuIncrements, NavSolution, NavStd, quality};
+
+use crate::io::{Location, LogError};
+
+/// Reads a whole file, mapping the OS error to [`LogError::Io`].
+pub(crate) fn read_file(path: &std::path::Path) -> Result<Vec<u8>, LogError> {
+    std::fs::read(path).map_err(|error| LogError::Io {
+        path: path.display().to_string(),
+        error,
+    })
+}
+
+/// Text of a file as UTF-8, or an error naming the first bad byte's line and column.
+pub(crate) fn as_utf8<'a>(bytes: &'a [u8], name: &str) -> Result<&'a str, LogError> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let good = &bytes[..e.valid_up_to()];
+        let line = good.iter().filter(|&&b| b == b'\n').count() + 1;
+        let col = good.len() - good.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1) + 1;
+        LogError::Malformed {
+            at: Location::field(name, line, col),
+            format: "text",
+            message: "invalid UTF-8".into(),
+        }
+    })
+}
+
+/// One whitespace/comma-separated field: its 1-based byte column and text.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Field<'a> {
+    pub col: usize,
+    pub text: &'a str,
+}
+
+/// Splits a line on any of `seps`, skipping empty pieces (as KF-GINS's loader does with
+/// `", \t"`), and records each field's 1-based byte column.
+pub(crate) fn split_fields<'a>(line: &'a str, seps: &[u8]) -> Vec<Field<'a>> {
+    let bytes = line.as_bytes();
+    let mut out = Vec::new();
+    let mut start: Option<usize> = None;
+    for (i, b) in bytes.iter().enumerate() {
+        if seps.contains(b) {
+            if let Some(s) = start.take() {
+                out.push(Field {
+                    col: s + 1,
+                    text: &line[s..i],
+                });
+            }
+        } else if start.is_none() {
+            start = Some(i);
+        }
+    }
+    if let Some(s) = start {
+        out.push(Field {
+            col: s + 1,
+            text: &line[s..],
+        });
+    }
+    out
+}
+
+/// Parses a finite f64 from one field; `field` is the 1-based field number, `name` the
+/// column's name (both for the message).
+pub(crate) fn parse_num(
+    f: Field<'_>,
+    name_path: &str,
+    line: usize,
+    field: usize,
+    name: &str,
+) -> Result<f64, LogError> {
+    let at = Location::field(name_path, line, f.col);
+    match f.text.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(LogError::NonFinite {
+            at,
+            value: crate::io::error::excerpt(f.text.as_bytes()),
+            field,
+            name: name.to_owned(),
+        }),
+        Err(_) => Err(LogError::NonNumeric {
+            at,
+            value: crate::io::error::excerpt(f.text.as_bytes()),
+            field,
+            name: name.to_owned(),
+        }),
+    }
+}
+
+/// Checks that `t` is strictly after `prev` (the previous data row's time).
+pub(crate) fn check_time_order(
+    t: f64,
+    prev: Option<f64>,
+    path: &str,
+    line: usize,
+    field: usize,
+    name: &str,
+) -> Result<(), LogError> {
+    if let Some(p) = prev {
+        if t == p {
+            return Err(LogError::DuplicateTime {
+                at: Location::line(path, line),
+                field,
+                name: name.to_owned(),
+                time_s: t,
+            });
+        }
+        if t < p {
+            return Err(LogError::NonMonotonicTime {
+                at: Location::line(path, line),
+                field,
+                name: name.to_owned(),
+                time_s: t,
+                previous_s: p,
+            });
+        }
+    }
+    Ok(())
+}

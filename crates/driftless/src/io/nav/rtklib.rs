@@ -1,0 +1,863 @@
+//! RTKLIB formats: `.pos` solution files and binary `.tag` time-tag files.
+//!
+//! **`.pos`** (RTKLIB `outsolheads`/`outsols`, layout learnt from RTKLIB's `solution.c`,
+//! no code taken): `%` lines are header/comments; the last `%` line naming the columns,
+//! e.g. `%  GPST  latitude(deg) longitude(deg) height(m) Q ns sdn(m) sde(m) sdu(m) sdne(m)
+//! sdeu(m) sdun(m) age(s) ratio [vn(m/s) ve(m/s) vu(m/s) sdvn sdve sdvu sdvne sdveu sdvun]`,
+//! fixes the columns; the reader finds them by name, so the optional velocity block is
+//! detected from that line. Each epoch starts with its time as two fields, either
+//! `YYYY/MM/DD HH:MM:SS.sss` or `WWWW SSSSSS.sss` (GPS week, seconds of week). Supported:
+//! time system GPST (UTC/JST need leap seconds and are refused with a message), positions
+//! as latitude/longitude in decimal degrees and ellipsoidal height (ECEF, ENU-baseline and
+//! deg-min-sec layouts are refused). Units at the edge: degrees → rad; RTKLIB's
+//! north/east/**up** velocity becomes NED (`vD = −vu`); σ_D is `sdu` and σ_vD is `sdvu`
+//! (a σ does not change sign). Cross-covariances (`sdne`…), `age` and `ratio` are checked
+//! to be numbers and not kept.
+//!
+//! **`.tag`** (RTKLIB stream time tags, written by `stream.c` when a file stream has the
+//! `::T` option; layout learnt from RTKLIB/demo5 `stream.c`, no code taken), little-endian:
+//!
+//! | bytes | content |
+//! |---|---|
+//! | 0–59 | text `TIMETAG RTKLIB <version>`, NUL-padded |
+//! | 60–63 | `tick_f`: u32 host tick at the start, ms |
+//! | 64–67 | u32 whole GPST seconds since 1970-01-01 (RTKLIB `gtime_t.time`) |
+//! | 68–75 | f64 fraction of the second |
+//! | 76… | records: u32 tick (ms since the start) + file position (u32, or u64 with `::P=8`) |
+//!
+//! (RTKLIB before 2.4.3/demo5 wrote the whole `gtime_t` structure instead of 4 + 8 bytes;
+//! that platform-dependent layout is not read.)
+
+use std::path::Path;
+
+use super::gpstime::{Calendar, GpsTime};
+use super::kfgins::{GnssReadOptions, check_lat_lon, check_sigma};
+use super::types::GnssFixes;
+use super::{Field, as_utf8, check_time_order, parse_num, read_file, split_fields};
+use crate::io::{Location, LogError};
+
+const FORMAT_POS: &str = "RTKLIB .pos";
+const FORMAT_TAG: &str = "RTKLIB .tag";
+
+fn malformed(at: Location, format: &'static str, message: impl Into<String>) -> LogError {
+    LogError::Malformed {
+        at,
+        format,
+        message: message.into(),
+    }
+}
+
+/// Column indices (into the fields after the two time fields) of a `.pos` layout.
+#[derive(Debug, Default)]
+struct PosColumns {
+    names: Vec<String>,
+    lat: usize,
+    lon: usize,
+    h: usize,
+    q: usize,
+    ns: Option<usize>,
+    sd: [usize; 3],
+    vel: Option<[usize; 3]>,
+    sdv: Option<[usize; 3]>,
+}
+
+fn parse_pos_header(line: &str, path: &str, line_no: usize) -> Result<PosColumns, LogError> {
+    let body = line.trim_start_matches('%');
+    let toks: Vec<&str> = body
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|t| !t.is_empty())
+        .collect();
+    let at = Location::line(path, line_no);
+    match toks.first().copied() {
+        Some("GPST") => {}
+        Some(ts @ ("UTC" | "JST" | "BJT")) => {
+            return Err(malformed(
+                at,
+                FORMAT_POS,
+                format!(
+                    "time system {ts} is not supported (it needs leap seconds); output the solution in GPST (RTKLIB option out-timesys=gpst)"
+                ),
+            ));
+        }
+        other => {
+            return Err(malformed(
+                at,
+                FORMAT_POS,
+                format!("column header must start with the time system GPST, found {other:?}"),
+            ));
+        }
+    }
+    let names: Vec<String> = toks[1..].iter().map(|s| s.to_string()).collect();
+    let find = |n: &str| names.iter().position(|x| x == n);
+    let need = |n: &str| {
+        find(n).ok_or_else(|| {
+            malformed(
+                Location::line(path, line_no),
+                FORMAT_POS,
+                format!("column header lacks the column {n}"),
+            )
+        })
+    };
+    let lat = need("latitude(deg)")?;
+    let vel = match (find("vn(m/s)"), find("ve(m/s)"), find("vu(m/s)")) {
+        (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+        _ => None,
+    };
+    let sdv = match (find("sdvn"), find("sdve"), find("sdvu")) {
+        (Some(a), Some(b), Some(c)) if vel.is_some() => Some([a, b, c]),
+        _ => None,
+    };
+    Ok(PosColumns {
+        lat,
+        lon: need("longitude(deg)")?,
+        h: need("height(m)")?,
+        q: need("Q")?,
+        ns: find("ns"),
+        sd: [need("sdn(m)")?, need("sde(m)")?, need("sdu(m)")?],
+        vel,
+        sdv,
+        names,
+    })
+}
+
+/// Parses the two time fields of an epoch.
+fn parse_pos_time(
+    f0: Field<'_>,
+    f1: Field<'_>,
+    path: &str,
+    line: usize,
+) -> Result<GpsTime, LogError> {
+    let bad = |f: Field<'_>, field: usize, name: &str| LogError::NonNumeric {
+        at: Location::field(path, line, f.col),
+        value: crate::io::error::excerpt(f.text.as_bytes()),
+        field,
+        name: name.to_owned(),
+    };
+    if f0.text.contains('/') {
+        let d: Vec<&str> = f0.text.split('/').collect();
+        let t: Vec<&str> = f1.text.split(':').collect();
+        if d.len() != 3 {
+            return Err(bad(f0, 1, "date (YYYY/MM/DD)"));
+        }
+        if t.len() != 3 {
+            return Err(bad(f1, 2, "time (HH:MM:SS)"));
+        }
+        let (Ok(year), Ok(month), Ok(day)) = (d[0].parse(), d[1].parse(), d[2].parse()) else {
+            return Err(bad(f0, 1, "date (YYYY/MM/DD)"));
+        };
+        let (Ok(hour), Ok(minute), Ok(second)) = (t[0].parse(), t[1].parse(), t[2].parse::<f64>())
+        else {
+            return Err(bad(f1, 2, "time (HH:MM:SS)"));
+        };
+        let c = Calendar {
+            year,
+            month,
+            day,
+            hour,
+            minute,
+            second,
+        };
+        GpsTime::from_calendar(&c).ok_or_else(|| LogError::InvalidValue {
+            at: Location::field(path, line, f0.col),
+            message: format!("invalid or pre-1980 GPST date/time {} {}", f0.text, f1.text),
+        })
+    } else {
+        let week: u16 = f0.text.parse().map_err(|_| bad(f0, 1, "GPS week"))?;
+        let sow = parse_num(f1, path, line, 2, "GPS seconds of week")?;
+        if !(0.0..super::gpstime::SECONDS_PER_WEEK).contains(&sow) {
+            return Err(LogError::InvalidValue {
+                at: Location::field(path, line, f1.col),
+                message: format!("seconds of week {sow} outside [0, 604800)"),
+            });
+        }
+        Ok(GpsTime { week, sow_s: sow })
+    }
+}
+
+fn small_int(
+    v: f64,
+    max: u8,
+    f: Field<'_>,
+    path: &str,
+    line: usize,
+    name: &str,
+) -> Result<u8, LogError> {
+    if v.fract() != 0.0 || v < 0.0 || v > f64::from(max) {
+        return Err(LogError::InvalidValue {
+            at: Location::field(path, line, f.col),
+            message: format!("column {name} must be an integer in [0, {max}], found {v}"),
+        });
+    }
+    Ok(v as u8)
+}
+
+/// Reads an RTKLIB `.pos` file (see the module docs).
+pub fn read_rtklib_pos_file(
+    path: impl AsRef<Path>,
+    opts: &GnssReadOptions,
+) -> Result<GnssFixes, LogError> {
+    let path = path.as_ref();
+    read_rtklib_pos(&read_file(path)?, &path.display().to_string(), opts)
+}
+
+/// Reads RTKLIB `.pos` text from memory; `name` is used in error messages. `time_s` is
+/// seconds of the week of the first epoch (`gps_week`).
+pub fn read_rtklib_pos(
+    bytes: &[u8],
+    name: &str,
+    opts: &GnssReadOptions,
+) -> Result<GnssFixes, LogError> {
+    let text = as_utf8(bytes, name)?;
+    let mut cols: Option<PosColumns> = None;
+    let mut out = GnssFixes::default();
+    let (mut vel, mut sdv, mut ns) = (Vec::new(), Vec::new(), Vec::new());
+    let mut prev: Option<f64> = None;
+    let mut week0: Option<u16> = None;
+    let mut header_line = 0;
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let l = raw.strip_suffix('\r').unwrap_or(raw);
+        if l.trim().is_empty() {
+            continue;
+        }
+        if l.starts_with('%') {
+            if l.contains("x-ecef(m)") || l.contains("e-baseline(m)") || l.contains("latitude(d'") {
+                return Err(malformed(
+                    Location::line(name, line),
+                    FORMAT_POS,
+                    "only latitude/longitude in decimal degrees is supported (RTKLIB out-solformat=llh, out-degform=deg)",
+                ));
+            }
+            if l.contains("latitude(deg)") {
+                if !out.is_empty() {
+                    return Err(malformed(
+                        Location::line(name, line),
+                        FORMAT_POS,
+                        "a second column header after the first epoch",
+                    ));
+                }
+                cols = Some(parse_pos_header(l, name, line)?);
+                header_line = line;
+            }
+            continue;
+        }
+        let Some(c) = cols.as_ref() else {
+            return Err(malformed(
+                Location::line(name, line),
+                FORMAT_POS,
+                "epoch before the column header line (`%  GPST  latitude(deg) …`)",
+            ));
+        };
+        let fields = split_fields(l, b" \t,");
+        let expected = c.names.len() + 2;
+        if fields.len() != expected {
+            let col = fields.get(expected).map_or(l.len() + 1, |f| f.col);
+            return Err(LogError::Ragged {
+                at: Location::field(name, line, col),
+                found: fields.len(),
+                expected,
+                reference_line: header_line,
+            });
+        }
+        let t = parse_pos_time(fields[0], fields[1], name, line)?;
+        let w0 = *week0.get_or_insert(t.week);
+        if t.week < w0 {
+            return Err(LogError::NonMonotonicTime {
+                at: Location::line(name, line),
+                field: 1,
+                name: "GPST".into(),
+                time_s: t.seconds_since_week(w0),
+                previous_s: prev.unwrap_or(0.0),
+            });
+        }
+        let time_s = t.seconds_since_week(w0);
+        check_time_order(time_s, prev, name, line, 1, "GPST")?;
+        prev = Some(time_s);
+        let mut v = Vec::with_capacity(c.names.len());
+        for (k, f) in fields[2..].iter().enumerate() {
+            v.push(parse_num(*f, name, line, k + 3, &c.names[k])?);
+        }
+        let fld = |k: usize| fields[k + 2];
+        check_lat_lon(v[c.lat], v[c.lon], name, line, fld(c.lat), fld(c.lon))?;
+        let mut sig = [0.0; 3];
+        for (s, &k) in sig.iter_mut().zip(&c.sd) {
+            *s = check_sigma(
+                v[k],
+                false,
+                opts,
+                Location::field(name, line, fld(k).col),
+                &c.names[k],
+            )?;
+        }
+        out.time_s.push(time_s);
+        out.lat_rad.push(v[c.lat].to_radians());
+        out.lon_rad.push(v[c.lon].to_radians());
+        out.height_m.push(v[c.h]);
+        out.sigma_ned_m.push(sig);
+        out.quality
+            .push(small_int(v[c.q], 7, fld(c.q), name, line, "Q")?);
+        if let Some(k) = c.ns {
+            ns.push(small_int(v[k], u8::MAX, fld(k), name, line, "ns")?);
+        }
+        if let Some([n, e, u]) = c.vel {
+            vel.push([v[n], v[e], -v[u]]);
+        }
+        if let Some(ks) = c.sdv {
+            let mut s = [0.0; 3];
+            for (o, &k) in s.iter_mut().zip(&ks) {
+                *o = check_sigma(
+                    v[k],
+                    true,
+                    opts,
+                    Location::field(name, line, fld(k).col),
+                    &c.names[k],
+                )?;
+            }
+            sdv.push(s);
+        }
+    }
+    if out.is_empty() {
+        return Err(LogError::Empty {
+            at: Location::input(name),
+        });
+    }
+    out.gps_week = week0;
+    if let Some(c) = cols {
+        if c.ns.is_some() {
+            out.n_sats = Some(ns);
+        }
+        if c.vel.is_some() {
+            out.vel_ned_m_s = Some(vel);
+        }
+        if c.sdv.is_some() {
+            out.sigma_vel_ned_m_s = Some(sdv);
+        }
+    }
+    Ok(out)
+}
+
+/// Size of the file-position field in `.tag` records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FposSize {
+    /// Choose from the data: 4 bytes when the body is a whole number of 8-byte records
+    /// with non-decreasing ticks and positions, else 8 bytes under the same test.
+    #[default]
+    Auto,
+    /// 4-byte positions (RTKLIB default).
+    Four,
+    /// 8-byte positions (RTKLIB stream option `::P=8`).
+    Eight,
+}
+
+/// A parsed RTKLIB `.tag` time-tag file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimeTag {
+    /// The header text, e.g. `TIMETAG RTKLIB demo5`.
+    pub header: String,
+    /// Host tick at the start of the recording, ms.
+    pub tick_f_ms: u32,
+    /// Start time (GPST) as RTKLIB stores it: whole seconds since 1970-01-01 (GPST scale).
+    pub start_gtime_s: u32,
+    /// Fraction of a second of the start time, s.
+    pub start_frac_s: f64,
+    /// Start time as GPS week and seconds of week.
+    pub start: GpsTime,
+    /// Tick of each record, ms since the start.
+    pub ticks_ms: Vec<u32>,
+    /// Byte position in the data file after each record's write.
+    pub fpos: Vec<u64>,
+    /// The record layout that was read.
+    pub fpos_size: FposSize,
+}
+
+/// Header size: 60 bytes of text + 4-byte tick.
+const TAG_HEADER: usize = 64;
+/// Header + 4-byte seconds + 8-byte fraction.
+const TAG_BODY_START: usize = 76;
+
+/// Reads an RTKLIB `.tag` file.
+pub fn read_rtklib_tag_file(path: impl AsRef<Path>, fpos: FposSize) -> Result<TimeTag, LogError> {
+    let path = path.as_ref();
+    read_rtklib_tag(&read_file(path)?, &path.display().to_string(), fpos)
+}
+
+fn u32_at(b: &[u8], off: usize) -> u32 {
+    let mut a = [0u8; 4];
+    a.copy_from_slice(&b[off..off + 4]);
+    u32::from_le_bytes(a)
+}
+
+fn records(body: &[u8], size: usize) -> Option<(Vec<u32>, Vec<u64>)> {
+    if !body.len().is_multiple_of(4 + size) {
+        return None;
+    }
+    let n = body.len() / (4 + size);
+    let (mut t, mut p) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for r in body.chunks_exact(4 + size) {
+        t.push(u32_at(r, 0));
+        p.push(if size == 4 {
+            u64::from(u32_at(r, 4))
+        } else {
+            let mut a = [0u8; 8];
+            a.copy_from_slice(&r[4..12]);
+            u64::from_le_bytes(a)
+        });
+    }
+    Some((t, p))
+}
+
+fn first_decrease(v: &[impl PartialOrd]) -> Option<usize> {
+    v.windows(2).position(|w| w[1] < w[0]).map(|i| i + 1)
+}
+
+/// Reads RTKLIB `.tag` bytes; `name` is used in error messages (which give byte offsets:
+/// a binary file has no lines).
+pub fn read_rtklib_tag(bytes: &[u8], name: &str, fpos: FposSize) -> Result<TimeTag, LogError> {
+    let at = || Location::input(name);
+    if bytes.len() < TAG_BODY_START {
+        return Err(LogError::Truncated {
+            at: at(),
+            message: format!(
+                "RTKLIB time-tag header needs {TAG_BODY_START} bytes, file has {}",
+                bytes.len()
+            ),
+        });
+    }
+    const MAGIC: &[u8] = b"TIMETAG RTKLIB";
+    if !bytes.starts_with(MAGIC) {
+        return Err(malformed(
+            at(),
+            FORMAT_TAG,
+            format!(
+                "does not start with \"TIMETAG RTKLIB\" (found {:?})",
+                crate::io::error::excerpt(&bytes[..MAGIC.len()])
+            ),
+        ));
+    }
+    let text = &bytes[..TAG_HEADER - 4];
+    let end = text.iter().position(|&b| b == 0).unwrap_or(text.len());
+    let header = String::from_utf8_lossy(&text[..end]).into_owned();
+    let tick_f_ms = u32_at(bytes, 60);
+    let start_gtime_s = u32_at(bytes, 64);
+    let mut a = [0u8; 8];
+    a.copy_from_slice(&bytes[68..76]);
+    let start_frac_s = f64::from_le_bytes(a);
+    if !(0.0..1.0).contains(&start_frac_s) {
+        return Err(malformed(
+            at(),
+            FORMAT_TAG,
+            format!("start-time fraction {start_frac_s} at byte 68 is not in [0, 1)"),
+        ));
+    }
+    let start = GpsTime::from_gtime(i64::from(start_gtime_s), start_frac_s).ok_or_else(|| {
+        malformed(
+            at(),
+            FORMAT_TAG,
+            format!("start time {start_gtime_s} s since 1970 is before the GPS epoch"),
+        )
+    })?;
+    let body = &bytes[TAG_BODY_START..];
+    let ordered =
+        |r: &(Vec<u32>, Vec<u64>)| first_decrease(&r.0).is_none() && first_decrease(&r.1).is_none();
+    let (ticks_ms, fpos_v, size) = match fpos {
+        FposSize::Four | FposSize::Eight => {
+            let size = if fpos == FposSize::Four { 4 } else { 8 };
+            let rec = 4 + size;
+            let Some((t, p)) = records(body, size) else {
+                let whole = body.len() / rec;
+                return Err(LogError::Truncated {
+                    at: at(),
+                    message: format!(
+                        "time-tag record {} at byte {} has {} of {rec} bytes",
+                        whole + 1,
+                        TAG_BODY_START + whole * rec,
+                        body.len() % rec
+                    ),
+                });
+            };
+            if let Some(i) = first_decrease(&t) {
+                return Err(malformed(
+                    at(),
+                    FORMAT_TAG,
+                    format!(
+                        "tick goes backwards at record {} (byte {})",
+                        i + 1,
+                        TAG_BODY_START + i * rec
+                    ),
+                ));
+            }
+            (t, p, fpos)
+        }
+        FposSize::Auto => {
+            if let Some(r) = records(body, 4).filter(ordered) {
+                (r.0, r.1, FposSize::Four)
+            } else if let Some(r) = records(body, 8).filter(ordered) {
+                (r.0, r.1, FposSize::Eight)
+            } else if !body.len().is_multiple_of(4) {
+                let whole = body.len() / 8;
+                return Err(LogError::Truncated {
+                    at: at(),
+                    message: format!(
+                        "time-tag record {} at byte {} has {} of 8 bytes",
+                        whole + 1,
+                        TAG_BODY_START + whole * 8,
+                        body.len() % 8
+                    ),
+                });
+            } else {
+                return Err(malformed(
+                    at(),
+                    FORMAT_TAG,
+                    "records are neither 8-byte nor 12-byte (tick, file position) pairs with increasing ticks and positions (truncated or corrupt)",
+                ));
+            }
+        }
+    };
+    Ok(TimeTag {
+        header,
+        tick_f_ms,
+        start_gtime_s,
+        start_frac_s,
+        start,
+        ticks_ms,
+        fpos: fpos_v,
+        fpos_size: size,
+    })
+}
+
+/// How device ticks of a tick-stamped data file (e.g. the IMU CSV's `tick [ms]` column)
+/// are mapped to GPS time with a `.tag` file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TickMapping {
+    /// First device tick → the tag's start time; last device tick → start + the tag's
+    /// last record tick; linear in between. This rescales the device clock to the host
+    /// clock over the recording; it is what the data's authors do
+    /// (rtklibexplorer/GNSS_IMU `convert_imu_file.py`).
+    #[default]
+    Stretch,
+    /// First device tick → the tag's start time, then 1 ms per tick (device clock trusted).
+    Offset,
+}
+
+/// GPS times of a tick-stamped series.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TaggedTimes {
+    /// GPS week of the tag's start.
+    pub gps_week: u16,
+    /// Seconds of week `gps_week` (may pass 604 800 across a week boundary).
+    pub time_s: Vec<f64>,
+}
+
+/// Maps device ticks \[ms\] to GPS time with a `.tag` file (see [`TickMapping`]).
+/// `ticks_ms` must be finite and strictly increasing; `name` and `first_line` (the line of
+/// `ticks_ms[0]` in the caller's file) locate errors.
+pub fn map_ticks_to_gps(
+    tag: &TimeTag,
+    ticks_ms: &[f64],
+    mapping: TickMapping,
+    name: &str,
+    first_line: usize,
+) -> Result<TaggedTimes, LogError> {
+    let (Some(&t0), Some(&tn)) = (ticks_ms.first(), ticks_ms.last()) else {
+        return Err(LogError::Empty {
+            at: Location::input(name),
+        });
+    };
+    for (i, &t) in ticks_ms.iter().enumerate() {
+        if !t.is_finite() {
+            return Err(LogError::InvalidValue {
+                at: Location::line(name, first_line + i),
+                message: format!("non-finite tick {t}"),
+            });
+        }
+        if i > 0 {
+            check_time_order(t, Some(ticks_ms[i - 1]), name, first_line + i, 0, "tick_ms")?;
+        }
+    }
+    let scale = match mapping {
+        TickMapping::Offset => 1e-3,
+        TickMapping::Stretch => {
+            let span_s = tag.ticks_ms.last().map_or(0.0, |&t| f64::from(t) * 1e-3);
+            if span_s <= 0.0 || tn <= t0 {
+                return Err(LogError::InvalidOptions {
+                    at: Location::input(name),
+                    message: "the stretch mapping needs at least two device ticks and a time-tag file with records".into(),
+                });
+            }
+            span_s / (tn - t0)
+        }
+    };
+    let start = tag.start.sow_s;
+    Ok(TaggedTimes {
+        gps_week: tag.start.week,
+        time_s: ticks_ms.iter().map(|&t| start + (t - t0) * scale).collect(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const POS: &str = "\
+% program   : handmade test fixture
+% (lat/lon/height=WGS84/ellipsoidal,Q=1:fix,2:float,3:sbas,4:dgps,5:single,6:ppp,ns=# of satellites)
+%  GPST            latitude(deg) longitude(deg) height(m) Q  ns  sdn(m) sde(m) sdu(m) sdne(m) sdeu(m) sdun(m) age(s) ratio vn(m/s) ve(m/s) vu(m/s) sdvn sdve sdvu sdvne sdveu sdvun
+2025/07/08 19:34:18.500 40.0 -105.0 1601.5 1 21 0.01 0.02 0.03 0 0 0 0.0 3.2 1.0 2.0 0.5 0.05 0.06 0.07 0 0 0
+2025/07/08 19:34:18.750 40.1 -105.1 1601.6 2 20 0.01 0.02 0.03 0 0 0 0.0 3.2 1.0 2.0 -0.5 0.05 0.06 0.07 0 0 0
+";
+
+    #[test]
+    fn pos_with_velocity() {
+        let g = read_rtklib_pos(POS.as_bytes(), "p.pos", &GnssReadOptions::default()).unwrap();
+        assert_eq!(g.len(), 2);
+        assert_eq!(g.gps_week, Some(2374));
+        assert_eq!(g.time_s, vec![243_258.5, 243_258.75]);
+        assert!((g.lat_rad[1] - 40.1f64.to_radians()).abs() < 1e-15);
+        assert_eq!(g.quality, vec![1, 2]);
+        assert_eq!(g.n_sats, Some(vec![21, 20]));
+        assert_eq!(g.sigma_ned_m[0], [0.01, 0.02, 0.03]);
+        // NEU → NED.
+        assert_eq!(g.vel_ned_m_s.as_ref().unwrap()[0], [1.0, 2.0, -0.5]);
+        assert_eq!(g.vel_ned_m_s.as_ref().unwrap()[1], [1.0, 2.0, 0.5]);
+        assert_eq!(g.sigma_vel_ned_m_s.as_ref().unwrap()[1], [0.05, 0.06, 0.07]);
+    }
+
+    #[test]
+    fn pos_week_tow_without_velocity() {
+        let t = "%  GPST latitude(deg) longitude(deg) height(m) Q ns sdn(m) sde(m) sdu(m) sdne(m) sdeu(m) sdun(m) age(s) ratio\n\
+                 2374 604799.000 40 -105 1600 5 8 1.5 1.5 3 0 0 0 0 0\n\
+                 2375 0.500 40 -105 1600 5 8 1.5 1.5 3 0 0 0 0 0\n";
+        let g = read_rtklib_pos(t.as_bytes(), "p", &GnssReadOptions::default()).unwrap();
+        assert_eq!(g.gps_week, Some(2374));
+        // Across the week boundary the column keeps increasing.
+        assert_eq!(g.time_s, vec![604_799.0, 604_800.5]);
+        assert!(g.vel_ned_m_s.is_none() && g.sigma_vel_ned_m_s.is_none());
+    }
+
+    #[test]
+    fn pos_errors() {
+        let opts = GnssReadOptions::default();
+        let hdr = POS.lines().take(3).collect::<Vec<_>>().join("\n") + "\n";
+        let row = POS.lines().nth(3).unwrap();
+        // Missing column.
+        let t = format!("{hdr}{}\n", row.rsplit_once(' ').unwrap().0);
+        let e = read_rtklib_pos(t.as_bytes(), "p", &opts).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                LogError::Ragged {
+                    found: 23,
+                    expected: 24,
+                    reference_line: 3,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // Extra column.
+        let t = format!("{hdr}{row} 9\n");
+        assert!(matches!(
+            read_rtklib_pos(t.as_bytes(), "p", &opts).unwrap_err(),
+            LogError::Ragged { found: 25, .. }
+        ));
+        // Non-numeric latitude, named by column.
+        let t = format!("{hdr}{}\n", row.replace(" 40.0 ", " 4O.0 "));
+        let e = read_rtklib_pos(t.as_bytes(), "p", &opts).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "p:4:25: non-numeric value \"4O.0\" in column 3 (latitude(deg))"
+        );
+        // Bad time.
+        let t = format!("{hdr}{}\n", row.replace("19:34:18.500", "19:34"));
+        assert!(matches!(
+            read_rtklib_pos(t.as_bytes(), "p", &opts).unwrap_err(),
+            LogError::NonNumeric { field: 2, .. }
+        ));
+        // Duplicated and out-of-order epochs.
+        let t = format!("{hdr}{row}\n{row}\n");
+        let e = read_rtklib_pos(t.as_bytes(), "p", &opts).unwrap_err();
+        assert!(
+            matches!(e, LogError::DuplicateTime { .. }) && e.line() == Some(5),
+            "{e}"
+        );
+        let earlier = row.replace("18.500", "17.000");
+        let t = format!("{hdr}{row}\n{earlier}\n");
+        assert!(matches!(
+            read_rtklib_pos(t.as_bytes(), "p", &opts).unwrap_err(),
+            LogError::NonMonotonicTime { .. }
+        ));
+        // σ = 0.
+        let t = format!("{hdr}{}\n", row.replace(" 0.02 0.03 ", " 0 0.03 "));
+        let e = read_rtklib_pos(t.as_bytes(), "p", &opts).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("standard deviation 0 in column sde(m)"),
+            "{e}"
+        );
+        // Q not an integer flag.
+        let t = format!("{hdr}{}\n", row.replace(" 1 21 ", " 1.5 21 "));
+        assert!(read_rtklib_pos(t.as_bytes(), "p", &opts).is_err());
+        // UTC, ECEF, no header.
+        let t = hdr.replace("GPST", "UTC ") + row + "\n";
+        let e = read_rtklib_pos(t.as_bytes(), "p", &opts).unwrap_err();
+        assert!(e.to_string().contains("leap seconds"), "{e}");
+        let t = "%  GPST x-ecef(m) y-ecef(m) z-ecef(m) Q ns\n";
+        assert!(matches!(
+            read_rtklib_pos(t.as_bytes(), "p", &opts).unwrap_err(),
+            LogError::Malformed { .. }
+        ));
+        let e = read_rtklib_pos(format!("{row}\n").as_bytes(), "p", &opts).unwrap_err();
+        assert!(e.to_string().contains("before the column header"), "{e}");
+        assert!(matches!(
+            read_rtklib_pos(hdr.as_bytes(), "p", &opts).unwrap_err(),
+            LogError::Empty { .. }
+        ));
+    }
+
+    /// A small tag file built byte by byte from the documented layout.
+    fn tag_bytes(records: &[(u32, u32)]) -> Vec<u8> {
+        let mut b = vec![0u8; 64];
+        b[..20].copy_from_slice(b"TIMETAG RTKLIB test1");
+        b[60..64].copy_from_slice(&1000u32.to_le_bytes());
+        b.extend_from_slice(&1_752_003_261u32.to_le_bytes());
+        b.extend_from_slice(&0.5f64.to_le_bytes());
+        for &(t, p) in records {
+            b.extend_from_slice(&t.to_le_bytes());
+            b.extend_from_slice(&p.to_le_bytes());
+        }
+        b
+    }
+
+    #[test]
+    fn tag_reads_and_maps() {
+        let b = tag_bytes(&[(100, 40), (200, 80), (10_000, 4000)]);
+        let tag = read_rtklib_tag(&b, "t.tag", FposSize::Auto).unwrap();
+        assert_eq!(tag.header, "TIMETAG RTKLIB test1");
+        assert_eq!(tag.tick_f_ms, 1000);
+        assert_eq!(tag.start.week, 2374);
+        assert_eq!(tag.start.sow_s, 243_261.5);
+        assert_eq!(tag.ticks_ms, vec![100, 200, 10_000]);
+        assert_eq!(tag.fpos, vec![40, 80, 4000]);
+        assert_eq!(tag.fpos_size, FposSize::Four);
+        // Device ticks 5000..=25000 ms (20 s) stretched onto the tag's 10 s.
+        let m = map_ticks_to_gps(
+            &tag,
+            &[5000.0, 15_000.0, 25_000.0],
+            TickMapping::Stretch,
+            "imu",
+            1,
+        )
+        .unwrap();
+        assert_eq!(m.gps_week, 2374);
+        assert_eq!(m.time_s, vec![243_261.5, 243_266.5, 243_271.5]);
+        let m = map_ticks_to_gps(&tag, &[5000.0, 6000.5], TickMapping::Offset, "imu", 1).unwrap();
+        assert_eq!(m.time_s, vec![243_261.5, 243_262.500_5]);
+        let e =
+            map_ticks_to_gps(&tag, &[1.0, 3.0, 2.0], TickMapping::Offset, "imu", 10).unwrap_err();
+        assert!(
+            matches!(e, LogError::NonMonotonicTime { .. }) && e.line() == Some(12),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn tag_truncated_and_corrupt() {
+        let b = tag_bytes(&[(100, 40), (200, 80)]);
+        // Header cut.
+        let e = read_rtklib_tag(&b[..70], "t.tag", FposSize::Auto).unwrap_err();
+        assert!(matches!(e, LogError::Truncated { .. }), "{e}");
+        // Last record cut (3 of 8 bytes).
+        let e = read_rtklib_tag(&b[..b.len() - 5], "t.tag", FposSize::Four).unwrap_err();
+        assert!(matches!(e, LogError::Truncated { .. }), "{e}");
+        assert!(
+            e.to_string()
+                .contains("record 2 at byte 84 has 3 of 8 bytes"),
+            "{e}"
+        );
+        let e = read_rtklib_tag(&b[..b.len() - 5], "t.tag", FposSize::Auto).unwrap_err();
+        assert!(matches!(e, LogError::Truncated { .. }), "{e}");
+        // Not a tag file.
+        let mut bad = b.clone();
+        bad[0] = b'X';
+        assert!(matches!(
+            read_rtklib_tag(&bad, "t.tag", FposSize::Auto).unwrap_err(),
+            LogError::Malformed { .. }
+        ));
+        // Ticks going backwards.
+        let b = tag_bytes(&[(200, 40), (100, 80)]);
+        assert!(read_rtklib_tag(&b, "t.tag", FposSize::Four).is_err());
+        assert!(read_rtklib_tag(&b, "t.tag", FposSize::Auto).is_err());
+    }
+
+    fn data_dir() -> std::path::PathBuf {
+        std::env::var("DRIFTLESS_DATA").map_or_else(
+            |_| std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
+            std::path::PathBuf::from,
+        )
+    }
+
+    #[test]
+    #[ignore = "needs shared data"]
+    fn drive_pos_and_tag() {
+        let dir = data_dir().join("drive/drive_0708");
+        let g = read_rtklib_pos_file(dir.join("gnss_1934_sf.pos"), &GnssReadOptions::default())
+            .unwrap();
+        assert_eq!(g.len(), 2197);
+        let fixed = g.quality.iter().filter(|&&q| q == 1).count() as f64 / g.len() as f64;
+        assert!(fixed > 0.995 && fixed < 0.997, "Q=1 fraction {fixed}");
+        assert_eq!(g.gps_week, Some(2374));
+        // 19:34:18.499 .. 19:43:27 GPST on Tuesday 2025-07-08.
+        assert!((g.time_s[0] - 243_258.499).abs() < 1e-6, "{}", g.time_s[0]);
+        let last = *g.time_s.last().unwrap();
+        assert!((243_807.0..243_808.0).contains(&last), "{last}");
+        assert!(g.vel_ned_m_s.is_some() && g.sigma_vel_ned_m_s.is_some());
+        let lat = g.lat_rad[0].to_degrees();
+        assert!((lat - 40.0966268).abs() < 1e-9 && (g.height_m[0] - 1601.474).abs() < 1e-9);
+        println!(
+            "pos: {} epochs, Q=1 {:.2} %, {:.3}..{:.3} s of week {}",
+            g.len(),
+            fixed * 100.0,
+            g.time_s[0],
+            last,
+            2374
+        );
+
+        let tag = read_rtklib_tag_file(dir.join("imu_1934.csv.tag"), FposSize::Auto).unwrap();
+        assert!(tag.header.starts_with("TIMETAG RTKLIB"));
+        assert_eq!(tag.fpos_size, FposSize::Four);
+        assert_eq!(tag.start.week, 2374);
+        assert!(
+            (tag.start.sow_s - 243_261.854).abs() < 1e-6,
+            "{}",
+            tag.start.sow_s
+        );
+        let csv = std::fs::read_to_string(dir.join("imu_1934.csv")).unwrap();
+        let ticks: Vec<f64> = csv
+            .lines()
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| l.rsplit(',').next().unwrap().trim().parse().unwrap())
+            .collect();
+        assert_eq!(ticks.len(), 54_860);
+        let m = map_ticks_to_gps(&tag, &ticks, TickMapping::Stretch, "imu_1934.csv", 1).unwrap();
+        let (t0, t1) = (m.time_s[0], *m.time_s.last().unwrap());
+        // The IMU span must overlap the RTK span, and cover most of it.
+        assert!(t0 < last && t1 > g.time_s[0]);
+        let overlap = t1.min(last) - t0.max(g.time_s[0]);
+        assert!(overlap > 540.0, "overlap {overlap} s");
+        assert!((t1 - t0 - 548.731).abs() < 1e-6, "span {}", t1 - t0);
+        let o = map_ticks_to_gps(&tag, &ticks, TickMapping::Offset, "imu_1934.csv", 1).unwrap();
+        // Device ticks span 548.590 s where the host's tag spans 548.731 s: trusting the
+        // device clock (Offset) ends 0.141 s (≈ 257 ppm) earlier than Stretch.
+        let d = o.time_s.last().unwrap() - t1;
+        assert!((d + 0.141).abs() < 1e-3, "offset-vs-stretch {d}");
+        println!(
+            "tag: start {:.3}, IMU {:.3}..{:.3} s ({} ticks, {} tag records), overlap {overlap:.3} s, offset-vs-stretch end {:.4} s",
+            tag.start.sow_s,
+            t0,
+            t1,
+            ticks.len(),
+            tag.ticks_ms.len(),
+            o.time_s.last().unwrap() - t1
+        );
+    }
+}
