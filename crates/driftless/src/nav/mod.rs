@@ -5,3 +5,4 @@
 
 pub mod attitude;
 pub mod earth;
+pub mod mechanization;

@@ -4,5 +4,6 @@
 //! * [`noise`]: static IMU noise (quantization, white, bias instability, rate random walk,
 //!   rate ramp, Gauss-Markov, turn-on bias) following IEEE Std 952-1997 Annex C.
 
+pub mod ideal_imu;
 pub mod noise;
 pub mod rng;
