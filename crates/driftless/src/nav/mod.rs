@@ -6,3 +6,5 @@
 pub mod attitude;
 pub mod earth;
 pub mod mechanization;
+pub mod outage;
+pub mod pipeline;
