@@ -5,6 +5,7 @@
 
 pub mod attitude;
 pub mod earth;
+pub mod filter;
 pub mod mechanization;
 pub mod outage;
 pub mod pipeline;

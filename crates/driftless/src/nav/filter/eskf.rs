@@ -1,0 +1,453 @@
+//! The 21-state closed-loop error-state Kalman filter.
+//!
+//! # Cycle
+//!
+//! * [`Eskf::predict`]: compensate the raw increment with the current sensor-error
+//!   estimates (Δθ̂ = (Δθ̃ − b̂_gΔt) ⊘ (1 + ŝ_g), Δv̂ likewise), mechanize
+//!   ([`mechanize`]), propagate P with Φ and Q_d built at the state of the start of the
+//!   interval ([`super::model`]). The error state itself stays zero (closed loop).
+//! * [`Eskf::update_position`] / [`Eskf::update_velocity`]: innovation, χ² gate, gain,
+//!   Joseph-form covariance update (Bucy & Joseph; Brown & Hwang 2012 §4.2, eq. 4.2.18),
+//!   P⁺ = (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ, which keeps P symmetric PD under rounding and
+//!   for any K; then feedback of δx̂ = K y into the navigation state and the sensor
+//!   estimates, and reset of δx̂ to zero. (The reset Jacobian I − ½[δφ×] of Groves
+//!   §14.2.7 / Shin §3.4 is taken as I: its effect is second order in the corrections.)
+//!   After each update P is checked for symmetry, finiteness and positive definiteness
+//!   (Cholesky); failure is a [`NavError::Covariance`] with a diagnosis.
+//!
+//! # Measurement models (errors as in [`super`]: estimated minus true)
+//!
+//! Position of the antenna at lever arm l (body) from the IMU: r_a = r + C_bn l. The
+//! innovation is y = (Ĉ_bn l) − Δr_meas, Δr_meas the NED offset (m) of the GNSS fix from
+//! the estimated IMU position (radii at the estimate), i.e. predicted minus measured
+//! antenna position. With Ĉ = (I − [φ×])C: Ĉl = Cl + (Ĉl) × φ, so
+//! y = δr + [(Ĉ_bn l)×] φ + noise, H_r = [I₃, 0, [(Ĉ_bn l)×], 0, …] (Shin 2005 ch. 4;
+//! Groves 2013 §14.3.1 lever-arm model; sign derived here for this error convention).
+//!
+//! Velocity of the antenna: v_a = v + C_bn(ω_ib^b × l) − ω_in^n × (C_bn l) (Groves
+//! §14.3.1; the ω_in term is ≤ 1e-4·|l| m/s and enters the prediction only).
+//! y = v̂_a − v_meas = δv + [(Ĉ(ω̂×l))×] φ − Ĉ[l×] b_g − Ĉ[l×]diag(ω̂) s_g + noise.
+//!
+//! # Attitude feedback
+//!
+//! From Ĉ = (I − [φ×]) C the corrected attitude is C = (I − [φ×])⁻¹ Ĉ ≈ (I + [φ×]) Ĉ,
+//! applied exactly as a rotation on the navigation side: q_bn ← q(φ) ⊗ q̂_bn, q(φ) the
+//! quaternion of the rotation vector φ (Groves §14.2.7 with the opposite sign convention
+//! for the error; Shin §3.4).
+
+use driftless_model::linalg::{Mat3, Vec3, cross, sub};
+
+use super::NavError;
+use super::model::{FilterConfig, Transition, omega_in, skew};
+use super::state::{
+    ATT, BA, BG, Cov, N_STATES, POS, SA, SG, SensorErrors, VEL, check_covariance,
+    check_covariance_scaled, check_diagonal, state_name,
+};
+use crate::nav::attitude::Quat;
+use crate::nav::earth;
+use crate::nav::mechanization::{ImuIncrement, NavState, mechanize};
+
+/// Which measurement an update used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UpdateKind {
+    /// GNSS antenna position.
+    Position,
+    /// GNSS antenna velocity.
+    Velocity,
+}
+
+/// Result of one measurement update.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UpdateOutcome {
+    /// Measurement type.
+    pub kind: UpdateKind,
+    /// Epoch, s.
+    pub time_s: f64,
+    /// Innovation y (predicted − measured), NED, m or m/s.
+    pub innovation: Vec3,
+    /// Normalized innovation squared yᵀS⁻¹y.
+    pub nis: f64,
+    /// False when the χ² gate rejected the measurement (state and P untouched).
+    pub accepted: bool,
+}
+
+/// The filter. See the module documentation.
+#[derive(Clone, Debug)]
+pub struct Eskf {
+    nav: NavState,
+    sensors: SensorErrors,
+    p: Cov,
+    prev_inc: Option<ImuIncrement>,
+    last_omega_b_rad_s: Vec3,
+    q_c: [f64; N_STATES],
+    neg_inv_tau: [f64; 12],
+    chi2_gate: Option<f64>,
+    symmetry_tol: f64,
+}
+
+impl Eskf {
+    /// A filter at `nav` with sensor-error estimates `sensors`, initial covariance
+    /// `p0` (checked) and the noise model of `cfg` (validated). `prev_inc` is the raw
+    /// increment of the interval before `nav.time_s` (for the two-sample corrections), if
+    /// known.
+    pub fn new(
+        nav: NavState,
+        sensors: SensorErrors,
+        p0: Cov,
+        prev_inc: Option<ImuIncrement>,
+        cfg: &FilterConfig,
+    ) -> Result<Eskf, NavError> {
+        cfg.validate()?;
+        let ok = [nav.lat_rad, nav.lon_rad, nav.height_m, nav.time_s]
+            .iter()
+            .chain(nav.vel_ned_m_s.iter())
+            .chain(nav.q_bn.0.iter())
+            .all(|v| v.is_finite());
+        if !ok || nav.lat_rad.abs() >= 89.9f64.to_radians() {
+            return Err(NavError::Config(format!(
+                "initial state not finite or too close to a pole: {nav:?}"
+            )));
+        }
+        check_covariance(&p0, cfg.symmetry_tol).map_err(|d| NavError::Covariance {
+            time_s: nav.time_s,
+            diagnosis: format!("initial covariance: {d}"),
+        })?;
+        let mut f = Eskf {
+            nav,
+            sensors,
+            p: p0,
+            prev_inc: None,
+            last_omega_b_rad_s: [0.0; 3],
+            q_c: cfg.q_c_diag(),
+            neg_inv_tau: cfg.neg_inv_tau(),
+            chi2_gate: cfg.chi2_gate,
+            symmetry_tol: cfg.symmetry_tol,
+        };
+        f.nav.q_bn = f.nav.q_bn.normalized();
+        if let Some(raw) = prev_inc {
+            f.prev_inc = Some(f.compensate(&raw));
+        }
+        Ok(f)
+    }
+
+    /// Current navigation state (IMU centre).
+    pub fn nav(&self) -> &NavState {
+        &self.nav
+    }
+
+    /// Current sensor-error estimates.
+    pub fn sensors(&self) -> &SensorErrors {
+        &self.sensors
+    }
+
+    /// Current error covariance.
+    pub fn covariance(&self) -> &Cov {
+        &self.p
+    }
+
+    /// Mutable access to the covariance (diagnostics, fault injection in tests). The
+    /// next predict/update checks it.
+    pub fn covariance_mut(&mut self) -> &mut Cov {
+        &mut self.p
+    }
+
+    /// Standard deviations √P_ii (NaN-free: a non-positive variance gives 0; such a P
+    /// never survives a predict or update).
+    pub fn std(&self) -> [f64; N_STATES] {
+        std::array::from_fn(|i| self.p[i][i].max(0.0).sqrt())
+    }
+
+    /// Last compensated angular rate ω̂_ib^b, rad/s.
+    pub fn omega_ib_b_rad_s(&self) -> Vec3 {
+        self.last_omega_b_rad_s
+    }
+
+    /// The compensated increment used by the last predict.
+    pub fn last_compensated(&self) -> Option<ImuIncrement> {
+        self.prev_inc
+    }
+
+    /// Raw increment → compensated increment (module docs).
+    #[inline]
+    pub fn compensate(&self, raw: &ImuIncrement) -> ImuIncrement {
+        let s = &self.sensors;
+        let dt = raw.dt_s;
+        ImuIncrement {
+            time_s: raw.time_s,
+            dt_s: dt,
+            dtheta_rad: std::array::from_fn(|k| {
+                (raw.dtheta_rad[k] - s.gyro_bias_rad_s[k] * dt) / (1.0 + s.gyro_scale[k])
+            }),
+            dvel_m_s: std::array::from_fn(|k| {
+                (raw.dvel_m_s[k] - s.accel_bias_m_s2[k] * dt) / (1.0 + s.accel_scale[k])
+            }),
+        }
+    }
+
+    /// Time update over one raw increment ending at `raw.time_s` (interval `raw.dt_s`,
+    /// which must start at the current state time). Returns the transition used (the
+    /// smoother can also rebuild it, see [`super::run`]).
+    pub fn predict(&mut self, raw: &ImuIncrement) -> Result<Transition, NavError> {
+        let dt = raw.dt_s;
+        let finite = raw
+            .dtheta_rad
+            .iter()
+            .chain(raw.dvel_m_s.iter())
+            .all(|v| v.is_finite());
+        if !(dt.is_finite() && dt > 0.0 && dt < 10.0 && finite && raw.time_s.is_finite()) {
+            return Err(NavError::InvalidIncrement {
+                time_s: raw.time_s,
+                reason: format!(
+                    "dt = {dt} s, Δθ = {:?}, Δv = {:?}",
+                    raw.dtheta_rad, raw.dvel_m_s
+                ),
+            });
+        }
+        let comp = self.compensate(raw);
+        let inv = 1.0 / dt;
+        let omega = comp.dtheta_rad.map(|v| v * inv);
+        let f_b = comp.dvel_m_s.map(|v| v * inv);
+        let tr = Transition::new(&self.nav, omega, f_b, dt, &self.neg_inv_tau);
+        let prev = self.prev_inc.unwrap_or(comp);
+        let next = mechanize(&self.nav, &prev, &comp);
+        let ok = [next.lat_rad, next.lon_rad, next.height_m]
+            .iter()
+            .chain(next.vel_ned_m_s.iter())
+            .all(|v| v.is_finite());
+        if !ok {
+            return Err(NavError::InvalidIncrement {
+                time_s: raw.time_s,
+                reason: format!("navigation state became non-finite: {next:?}"),
+            });
+        }
+        self.nav = next;
+        self.prev_inc = Some(comp);
+        self.last_omega_b_rad_s = omega;
+        tr.propagate(&mut self.p, &self.q_c);
+        check_diagonal(&self.p).map_err(|(i, v)| NavError::Covariance {
+            time_s: raw.time_s,
+            diagnosis: format!(
+                "after prediction the variance of state {i} ({}) is {v:e}",
+                state_name(i)
+            ),
+        })?;
+        Ok(tr)
+    }
+
+    /// GNSS position update: `fix_llh` = (lat rad, lon rad, h m) of the antenna,
+    /// `sigma_ned_m` its σ (m, > 0), `lever_arm_b_m` the antenna offset from the IMU in
+    /// body axes. See the module docs for the model.
+    pub fn update_position(
+        &mut self,
+        fix_llh: [f64; 3],
+        sigma_ned_m: Vec3,
+        lever_arm_b_m: Vec3,
+    ) -> Result<UpdateOutcome, NavError> {
+        let t = self.nav.time_s;
+        check_meas(t, &fix_llh, &sigma_ned_m, &lever_arm_b_m)?;
+        let c_bn = self.nav.q_bn.to_dcm();
+        let cl = c_bn.mul_vec(lever_arm_b_m);
+        let d = earth::ned_offset_m(
+            (self.nav.lat_rad, self.nav.lon_rad, self.nav.height_m),
+            (fix_llh[0], fix_llh[1], fix_llh[2]),
+        );
+        let y = sub(cl, d);
+        let mut h = [[0.0; N_STATES]; 3];
+        let sk = skew(cl);
+        for m in 0..3 {
+            h[m][POS + m] = 1.0;
+            for k in 0..3 {
+                h[m][ATT + k] = sk[m][k];
+            }
+        }
+        const COLS: [usize; 6] = [POS, POS + 1, POS + 2, ATT, ATT + 1, ATT + 2];
+        self.update(UpdateKind::Position, y, &h, &COLS, sigma_ned_m)
+    }
+
+    /// GNSS velocity update: `v_ned_m_s` the antenna velocity, `sigma_ned_m_s` its σ.
+    pub fn update_velocity(
+        &mut self,
+        v_ned_m_s: Vec3,
+        sigma_ned_m_s: Vec3,
+        lever_arm_b_m: Vec3,
+    ) -> Result<UpdateOutcome, NavError> {
+        let t = self.nav.time_s;
+        check_meas(t, &v_ned_m_s, &sigma_ned_m_s, &lever_arm_b_m)?;
+        let c_bn = self.nav.q_bn.to_dcm();
+        let w = self.last_omega_b_rad_s;
+        let wxl = c_bn.mul_vec(cross(w, lever_arm_b_m));
+        let cl = c_bn.mul_vec(lever_arm_b_m);
+        let pred: Vec3 = std::array::from_fn(|k| {
+            self.nav.vel_ned_m_s[k] + wxl[k] - cross(omega_in(&self.nav), cl)[k]
+        });
+        let y = sub(pred, v_ned_m_s);
+        let s_att = skew(wxl);
+        let c_lx = (c_bn * Mat3::skew(lever_arm_b_m)).0;
+        let mut h = [[0.0; N_STATES]; 3];
+        for m in 0..3 {
+            h[m][VEL + m] = 1.0;
+            for k in 0..3 {
+                h[m][ATT + k] = s_att[m][k];
+                h[m][BG + k] = -c_lx[m][k];
+                h[m][SG + k] = -c_lx[m][k] * w[k];
+            }
+        }
+        const COLS: [usize; 12] = [3, 4, 5, 6, 7, 8, 9, 10, 11, 15, 16, 17];
+        self.update(UpdateKind::Velocity, y, &h, &COLS, sigma_ned_m_s)
+    }
+
+    /// Generic 3-dimensional update with H non-zero only in `cols`, R = diag(σ²).
+    fn update(
+        &mut self,
+        kind: UpdateKind,
+        y: Vec3,
+        h: &[[f64; N_STATES]; 3],
+        cols: &[usize],
+        sigma: Vec3,
+    ) -> Result<UpdateOutcome, NavError> {
+        let t = self.nav.time_s;
+        check_diagonal(&self.p).map_err(|(i, v)| NavError::Covariance {
+            time_s: t,
+            diagnosis: format!(
+                "before update the variance of state {i} ({}) is {v:e}",
+                state_name(i)
+            ),
+        })?;
+        let p = &self.p;
+        // PHᵀ (21 × 3).
+        let mut pht = [[0.0; 3]; N_STATES];
+        for (i, row) in pht.iter_mut().enumerate() {
+            for (m, v) in row.iter_mut().enumerate() {
+                *v = cols.iter().map(|&c| p[i][c] * h[m][c]).sum();
+            }
+        }
+        let r = sigma.map(|s| s * s);
+        let mut s = [[0.0; 3]; 3];
+        for m in 0..3 {
+            for n in 0..3 {
+                s[m][n] = cols.iter().map(|&c| h[m][c] * pht[c][n]).sum::<f64>();
+            }
+            s[m][m] += r[m];
+        }
+        // Symmetrize S against rounding before inverting.
+        for m in 0..3 {
+            for n in (m + 1)..3 {
+                let a = 0.5 * (s[m][n] + s[n][m]);
+                s[m][n] = a;
+                s[n][m] = a;
+            }
+        }
+        let s_inv = Mat3(s).inverse().ok_or_else(|| NavError::Covariance {
+            time_s: t,
+            diagnosis: format!("innovation covariance S = {s:?} is singular"),
+        })?;
+        let siy = s_inv.mul_vec(y);
+        let nis = y[0] * siy[0] + y[1] * siy[1] + y[2] * siy[2];
+        if !nis.is_finite() || nis < 0.0 {
+            return Err(NavError::Covariance {
+                time_s: t,
+                diagnosis: format!(
+                    "innovation covariance S = {s:?} is not positive definite (NIS {nis})"
+                ),
+            });
+        }
+        let accepted = self.chi2_gate.is_none_or(|g| nis <= g);
+        let out = UpdateOutcome {
+            kind,
+            time_s: t,
+            innovation: y,
+            nis,
+            accepted,
+        };
+        if !accepted {
+            return Ok(out);
+        }
+        // K = PHᵀS⁻¹, δx = K y.
+        let mut k = [[0.0; 3]; N_STATES];
+        let mut dx = [0.0; N_STATES];
+        for i in 0..N_STATES {
+            for n in 0..3 {
+                k[i][n] = (0..3).map(|m| pht[i][m] * s_inv.0[m][n]).sum();
+            }
+            dx[i] = k[i][0] * y[0] + k[i][1] * y[1] + k[i][2] * y[2];
+        }
+        // Joseph form: W = (I − KH)P = P − K(PHᵀ)ᵀ; P⁺ = W − (WHᵀ)Kᵀ + K R Kᵀ.
+        let mut w = *p;
+        for i in 0..N_STATES {
+            for j in 0..N_STATES {
+                w[i][j] -= k[i][0] * pht[j][0] + k[i][1] * pht[j][1] + k[i][2] * pht[j][2];
+            }
+        }
+        let mut wht = [[0.0; 3]; N_STATES];
+        for i in 0..N_STATES {
+            for m in 0..3 {
+                wht[i][m] = cols.iter().map(|&c| w[i][c] * h[m][c]).sum();
+            }
+        }
+        let mut pn = w;
+        for i in 0..N_STATES {
+            for j in 0..N_STATES {
+                let mut a = 0.0;
+                for m in 0..3 {
+                    a += (k[i][m] * r[m] - wht[i][m]) * k[j][m];
+                }
+                pn[i][j] += a;
+            }
+        }
+        let prior_diag: [f64; N_STATES] = std::array::from_fn(|i| p[i][i]);
+        check_covariance_scaled(&pn, self.symmetry_tol, &prior_diag).map_err(|d| {
+            NavError::Covariance {
+                time_s: t,
+                diagnosis: format!("after {kind:?} update: {d}"),
+            }
+        })?;
+        for i in 0..N_STATES {
+            for j in (i + 1)..N_STATES {
+                let a = 0.5 * (pn[i][j] + pn[j][i]);
+                pn[i][j] = a;
+                pn[j][i] = a;
+            }
+        }
+        self.p = pn;
+        self.feedback(&dx);
+        Ok(out)
+    }
+
+    /// Apply the estimated error state and reset it (module docs).
+    fn feedback(&mut self, dx: &[f64; N_STATES]) {
+        let n = &mut self.nav;
+        let rm_h = earth::meridian_radius_m(n.lat_rad) + n.height_m;
+        let rn_h = earth::prime_vertical_radius_m(n.lat_rad) + n.height_m;
+        n.lon_rad -= dx[POS + 1] / (rn_h * n.lat_rad.cos());
+        n.lat_rad -= dx[POS] / rm_h;
+        n.height_m += dx[POS + 2];
+        for k in 0..3 {
+            n.vel_ned_m_s[k] -= dx[VEL + k];
+        }
+        let phi = [dx[ATT], dx[ATT + 1], dx[ATT + 2]];
+        n.q_bn = Quat::from_rotation_vector(phi).mul(&n.q_bn).normalized();
+        let s = &mut self.sensors;
+        for k in 0..3 {
+            s.gyro_bias_rad_s[k] += dx[BG + k];
+            s.accel_bias_m_s2[k] += dx[BA + k];
+            s.gyro_scale[k] += dx[SG + k];
+            s.accel_scale[k] += dx[SA + k];
+        }
+    }
+}
+
+fn check_meas(t: f64, value: &[f64; 3], sigma: &Vec3, lever: &Vec3) -> Result<(), NavError> {
+    if !value.iter().chain(lever.iter()).all(|v| v.is_finite()) {
+        return Err(NavError::InvalidMeasurement {
+            time_s: t,
+            reason: format!("non-finite value {value:?} or lever arm {lever:?}"),
+        });
+    }
+    if !sigma.iter().all(|s| s.is_finite() && *s > 0.0) {
+        return Err(NavError::InvalidMeasurement {
+            time_s: t,
+            reason: format!("σ = {sigma:?} must be finite and > 0"),
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,789 @@
+//! Error dynamics, process noise and covariance propagation of the 21-state filter.
+//!
+//! # Continuous-time error model (NED, phi-angle)
+//!
+//! Sources: Shin 2005 ch. 3 (error states in NED metres, phi-angle attitude error);
+//! Groves 2013 §14.2.4 (local-navigation-frame error equations); Titterton & Weston 2004
+//! §12.3. Errors as in [`super`] (estimated minus true; sensor states are residual errors
+//! of the compensated outputs). With R_M, R_N the meridian/prime-vertical radii,
+//! ω_in = ω_ie + ω_en and the sensor-error coupling
+//! δω_ib^b = b_g + diag(ω_ib^b) s_g, δf^b = b_a + diag(f^b) s_a:
+//!
+//! * position: δṙ = F_rr δr + δv with (ignoring dR/dφ) F_rr rows
+//!   (−v_D/(R_M+h), 0, v_N/(R_M+h)),
+//!   (v_E tan φ/(R_M+h), −(v_D/(R_N+h) + v_N tan φ/(R_M+h)), v_E/(R_N+h)), (0, 0, 0)
+//!   (differentiating δr_N = (R_M+h)δφ, δr_E = (R_N+h)cos φ δλ, δr_D = −δh along the
+//!   trajectory);
+//! * velocity: δv̇ = C_bn δf^b + f^n × φ − (2δω_ie + δω_en) × v − (2ω_ie + ω_en) × δv + δg,
+//!   δg = (0, 0, 2g/(√(R_M R_N)+h)·δr_D) (free-air gradient; the unstable vertical channel);
+//! * attitude: φ̇ = −ω_in × φ + δω_in − C_bn δω_ib^b;
+//!
+//! where δω_ie = ∂ω_ie/∂r δr and δω_en = ∂ω_en/∂r δr + ∂ω_en/∂v δv are written as the
+//! 3 × 3 Jacobians M_ie,r, M_en,r, M_en,v (δφ = δr_N/(R_M+h), δh = −δr_D);
+//! * sensor errors: first-order Gauss–Markov, ẋ = −x/T + w, E(w²) = q = 2σ²/T
+//!   (Brown & Hwang 2012 §4.2; Groves §14.2.7).
+//!
+//! Noise vector w = (w_v, w_φ, w_bg, w_ba, w_sg, w_sa): VRW and ARW enter as
+//! δv̇ += C_bn w_a, φ̇ −= C_bn w_g with PSDs VRW², ARW² (m²/s³, rad²/s), isotropic, so
+//! G Q Gᵀ is *diagonal*: q_c = (0₃, VRW²·1₃, ARW²·1₃, 2σ²/T per sensor state).
+//!
+//! # Discretization
+//!
+//! Over the IMU interval Δt (5 ms at 200 Hz) Φ ≈ I + FΔt (first order: the neglected
+//! ½(FΔt)² is ~1e-9 relative for a 200 Hz land vehicle), F evaluated at the state at the
+//! start of the interval with the compensated mean rate and specific force of the
+//! interval. Q_d by the trapezoid rule Q_d ≈ ½(Φ Q_c Φᵀ + Q_c)Δt (Brown & Hwang §3.9;
+//! Shin 2005 ch. 3), applied as
+//!
+//!   P⁻_{k+1} = Φ (P_k + ½Q_cΔt) Φᵀ + ½Q_cΔt,
+//!
+//! which is the same thing and costs only two diagonal additions because Q_c is diagonal.
+//!
+//! # Cost
+//!
+//! A = Φ − I = FΔt has 11 non-zero 3 × 3 blocks and a diagonal for the 12 sensor states
+//! ([`Transition`]), so ΦPΦᵀ = P + AP + (AP)ᵀ + A(AP)ᵀ is evaluated with 42 sparse
+//! matrix-vector products A·x (~110 multiply-adds each) instead of two dense 21³
+//! products; see [`Transition::propagate`].
+
+use driftless_model::linalg::{Mat3, Vec3, add, cross, scale};
+
+use super::NavError;
+use super::state::{ATT, BA, BG, Cov, N_STATES, POS, SA, SG, VEL};
+use crate::io::nav::quality;
+use crate::nav::earth;
+use crate::nav::mechanization::NavState;
+
+/// First-order Gauss–Markov process parameters: stationary σ (state units) and
+/// correlation time T (s). Driving-noise PSD q = 2σ²/T.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GaussMarkov {
+    /// Stationary standard deviation (rad/s, m/s² or dimensionless).
+    pub sigma: f64,
+    /// Correlation time T, s (> 0).
+    pub tau_s: f64,
+}
+
+impl GaussMarkov {
+    /// Continuous driving-noise PSD q = 2σ²/T.
+    pub fn psd(&self) -> f64 {
+        2.0 * self.sigma * self.sigma / self.tau_s
+    }
+}
+
+/// IMU noise and sensor-error model (e.g. from the Allan-variance noise-model file:
+/// ARW = white-noise coefficient N of the gyro, VRW = N of the accelerometer, bias
+/// instability → GM σ, RRW/long-term drift → T).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImuNoise {
+    /// Angle random walk, rad/√s (= rad/s/√Hz).
+    pub gyro_arw_rad_sqrt_s: f64,
+    /// Velocity random walk, m/s/√s.
+    pub accel_vrw_m_s_sqrt_s: f64,
+    /// Gyro bias, rad/s.
+    pub gyro_bias: GaussMarkov,
+    /// Accelerometer bias, m/s².
+    pub accel_bias: GaussMarkov,
+    /// Gyro scale-factor error, dimensionless.
+    pub gyro_scale: GaussMarkov,
+    /// Accelerometer scale-factor error, dimensionless.
+    pub accel_scale: GaussMarkov,
+}
+
+impl ImuNoise {
+    /// Noise parameters from an Allan-variance noise model (`allan::noise_model`, the
+    /// noise-model file), worst axis per sensor:
+    ///
+    /// * ARW / VRW = the white-noise coefficient N (rad/√s, m/s/√s);
+    /// * bias: a fitted Gauss–Markov term is used as is; otherwise a GM with correlation
+    ///   time `bias_tau_s` and σ² = B² + K²T/2, B the bias-instability coefficient and
+    ///   K the rate-random-walk coefficient (a random walk of PSD K² reaches the variance
+    ///   of a GM with q = 2σ²/T after ≈ T/2 — the usual first-order stand-in; Groves 2013
+    ///   §4.4.3 and §14.2.7; El-Sheimy, Hou & Niu 2008 for the Allan terms);
+    /// * scale factors are not observable in a static Allan recording and are given.
+    ///
+    /// Errors when a sensor has no channel or no white-noise term.
+    pub fn from_noise_model(
+        model: &crate::allan::noise_model::NoiseModel,
+        bias_tau_s: f64,
+        gyro_scale: GaussMarkov,
+        accel_scale: GaussMarkov,
+    ) -> Result<ImuNoise, NavError> {
+        use crate::allan::noise_model::Quantity;
+        if !(bias_tau_s.is_finite() && bias_tau_s > 0.0) {
+            return Err(NavError::Config(format!(
+                "bias correlation time {bias_tau_s} s"
+            )));
+        }
+        let pick = |q: Quantity| -> Result<(f64, GaussMarkov), NavError> {
+            let mut white: Option<f64> = None;
+            let mut bias = GaussMarkov {
+                sigma: 0.0,
+                tau_s: bias_tau_s,
+            };
+            for c in model.channels.iter().filter(|c| c.quantity == q) {
+                let f = &c.fit;
+                if let Some(w) = f.white {
+                    white = Some(white.map_or(w.value, |x: f64| x.max(w.value)));
+                }
+                let gm = if let Some(g) = f.gauss_markov {
+                    GaussMarkov {
+                        sigma: g.sigma.value,
+                        tau_s: g.tau_c_s.value,
+                    }
+                } else {
+                    let b = f.bias_instability.map_or(0.0, |t| t.value);
+                    let k = f.rate_random_walk.map_or(0.0, |t| t.value);
+                    GaussMarkov {
+                        sigma: (b * b + k * k * bias_tau_s / 2.0).sqrt(),
+                        tau_s: bias_tau_s,
+                    }
+                };
+                if gm.sigma > bias.sigma {
+                    bias = gm;
+                }
+            }
+            let white = white.ok_or_else(|| {
+                NavError::Config(format!("noise model has no {q:?} channel with white noise"))
+            })?;
+            if bias.sigma.is_nan() || bias.sigma <= 0.0 {
+                return Err(NavError::Config(format!(
+                    "noise model has no {q:?} bias term (bias instability, RRW or GM)"
+                )));
+            }
+            Ok((white, bias))
+        };
+        let (arw, gyro_bias) = pick(Quantity::AngularRate)?;
+        let (vrw, accel_bias) = pick(Quantity::SpecificForce)?;
+        Ok(ImuNoise {
+            gyro_arw_rad_sqrt_s: arw,
+            accel_vrw_m_s_sqrt_s: vrw,
+            gyro_bias,
+            accel_bias,
+            gyro_scale,
+            accel_scale,
+        })
+    }
+}
+
+/// Multipliers of the reported GNSS σ per RTKLIB quality flag (index = flag 0..=6:
+/// unspecified, fix, float, SBAS, DGPS, single, PPP). R = (k·σ)².
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QualityScale(pub [f64; 7]);
+
+impl Default for QualityScale {
+    /// Unspecified 1, fix 1, float 3, SBAS 10, DGPS 10, single 30, PPP 2. RTKLIB's σ of a
+    /// float or single solution is a formal precision that is typically optimistic by
+    /// these factors against a fixed reference; tune per receiver.
+    fn default() -> Self {
+        QualityScale([1.0, 1.0, 3.0, 10.0, 10.0, 30.0, 2.0])
+    }
+}
+
+impl QualityScale {
+    /// σ multiplier for a quality flag; unknown flags get the "single" factor.
+    pub fn factor(&self, q: u8) -> f64 {
+        self.0
+            .get(q as usize)
+            .copied()
+            .unwrap_or(self.0[quality::SINGLE as usize])
+    }
+}
+
+/// Filter configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilterConfig {
+    /// IMU noise / sensor-error model.
+    pub imu: ImuNoise,
+    /// GNSS antenna lever arm from the IMU centre, body FRD, m.
+    pub lever_arm_b_m: Vec3,
+    /// χ² gate on the normalized innovation squared (3 dof); `None` disables gating.
+    /// Default χ²₀.₉₉₉₉(3) = 21.108.
+    pub chi2_gate: Option<f64>,
+    /// σ multipliers per RTKLIB quality flag.
+    pub quality_scale: QualityScale,
+    /// Use GNSS velocity (when present) as a second update.
+    pub use_gnss_velocity: bool,
+    /// GNSS outage windows [start, end] (s, inclusive) during which fixes are withheld.
+    pub outages_s: Vec<(f64, f64)>,
+    /// Largest accepted IMU interval as a multiple of the nominal (first) interval;
+    /// longer gaps are an error. Default 2.5 (a gap of more than two samples).
+    pub max_gap_factor: f64,
+    /// Relative asymmetry tolerated in P before it is reported as corrupted.
+    pub symmetry_tol: f64,
+}
+
+/// χ²₀.₉₉₉₉ quantile for 3 degrees of freedom.
+pub const CHI2_3DOF_P9999: f64 = 21.108;
+
+impl FilterConfig {
+    /// A configuration with the given noise model and lever arm and defaults elsewhere.
+    pub fn new(imu: ImuNoise, lever_arm_b_m: Vec3) -> FilterConfig {
+        FilterConfig {
+            imu,
+            lever_arm_b_m,
+            chi2_gate: Some(CHI2_3DOF_P9999),
+            quality_scale: QualityScale::default(),
+            use_gnss_velocity: false,
+            outages_s: Vec::new(),
+            max_gap_factor: 2.5,
+            symmetry_tol: 1e-9,
+        }
+    }
+
+    /// Checks every value; a wrong unit typically shows as an absurd magnitude.
+    pub fn validate(&self) -> Result<(), NavError> {
+        let n = &self.imu;
+        let pos = |name: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(NavError::Config(format!(
+                    "{name} = {v} must be finite and ≥ 0"
+                )))
+            }
+        };
+        pos("gyro ARW (rad/√s)", n.gyro_arw_rad_sqrt_s)?;
+        pos("accel VRW (m/s/√s)", n.accel_vrw_m_s_sqrt_s)?;
+        if n.gyro_arw_rad_sqrt_s > 0.01 {
+            return Err(NavError::Config(format!(
+                "gyro ARW {} rad/√s = {:.0} °/√h is implausible: was it given in °/√h?",
+                n.gyro_arw_rad_sqrt_s,
+                n.gyro_arw_rad_sqrt_s.to_degrees() * 60.0
+            )));
+        }
+        for (name, gm) in [
+            ("gyro bias", n.gyro_bias),
+            ("accel bias", n.accel_bias),
+            ("gyro scale", n.gyro_scale),
+            ("accel scale", n.accel_scale),
+        ] {
+            if !(gm.sigma.is_finite() && gm.sigma > 0.0 && gm.tau_s.is_finite() && gm.tau_s > 0.0) {
+                return Err(NavError::Config(format!(
+                    "{name}: Gauss–Markov σ = {} and T = {} s must be finite and > 0",
+                    gm.sigma, gm.tau_s
+                )));
+            }
+        }
+        if n.gyro_bias.sigma > 0.1 {
+            return Err(NavError::Config(format!(
+                "gyro bias σ {} rad/s is implausible: was it given in °/h?",
+                n.gyro_bias.sigma
+            )));
+        }
+        if !self
+            .lever_arm_b_m
+            .iter()
+            .all(|v| v.is_finite() && v.abs() < 100.0)
+        {
+            return Err(NavError::Config(format!(
+                "lever arm {:?} m is not finite or longer than 100 m",
+                self.lever_arm_b_m
+            )));
+        }
+        if let Some(g) = self.chi2_gate
+            && !(g.is_finite() && g > 0.0)
+        {
+            return Err(NavError::Config(format!("χ² gate {g} must be > 0")));
+        }
+        if !self
+            .quality_scale
+            .0
+            .iter()
+            .all(|k| k.is_finite() && *k > 0.0)
+        {
+            return Err(NavError::Config("quality σ multipliers must be > 0".into()));
+        }
+        if !(self.max_gap_factor.is_finite() && self.max_gap_factor > 1.0) {
+            return Err(NavError::Config("max_gap_factor must be > 1".into()));
+        }
+        for &(a, b) in &self.outages_s {
+            if !(a.is_finite() && b.is_finite() && b >= a) {
+                return Err(NavError::Config(format!(
+                    "outage window ({a}, {b}) is invalid"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Diagonal of the continuous process-noise PSD G Q Gᵀ (module docs).
+    pub fn q_c_diag(&self) -> [f64; N_STATES] {
+        let n = &self.imu;
+        let mut q = [0.0; N_STATES];
+        for k in 0..3 {
+            q[VEL + k] = n.accel_vrw_m_s_sqrt_s * n.accel_vrw_m_s_sqrt_s;
+            q[ATT + k] = n.gyro_arw_rad_sqrt_s * n.gyro_arw_rad_sqrt_s;
+            q[BG + k] = n.gyro_bias.psd();
+            q[BA + k] = n.accel_bias.psd();
+            q[SG + k] = n.gyro_scale.psd();
+            q[SA + k] = n.accel_scale.psd();
+        }
+        q
+    }
+
+    /// −1/T for the 12 sensor states (b_g, b_a, s_g, s_a, three each).
+    pub fn neg_inv_tau(&self) -> [f64; 12] {
+        let n = &self.imu;
+        let mut r = [0.0; 12];
+        for k in 0..3 {
+            r[k] = -1.0 / n.gyro_bias.tau_s;
+            r[3 + k] = -1.0 / n.accel_bias.tau_s;
+            r[6 + k] = -1.0 / n.gyro_scale.tau_s;
+            r[9 + k] = -1.0 / n.accel_scale.tau_s;
+        }
+        r
+    }
+}
+
+type M3 = [[f64; 3]; 3];
+
+#[inline(always)]
+fn mv(m: &M3, x: &[f64]) -> Vec3 {
+    [
+        m[0][0] * x[0] + m[0][1] * x[1] + m[0][2] * x[2],
+        m[1][0] * x[0] + m[1][1] * x[1] + m[1][2] * x[2],
+        m[2][0] * x[0] + m[2][1] * x[1] + m[2][2] * x[2],
+    ]
+}
+
+fn sm(m: &M3, k: f64) -> M3 {
+    m.map(|r| r.map(|v| v * k))
+}
+
+fn madd(a: &M3, b: &M3) -> M3 {
+    let mut o = *a;
+    for i in 0..3 {
+        for j in 0..3 {
+            o[i][j] += b[i][j];
+        }
+    }
+    o
+}
+
+fn mmul(a: &M3, b: &M3) -> M3 {
+    Mat3(*a).mul_mat(&Mat3(*b)).0
+}
+
+/// The non-trivial blocks of A = Φ − I = FΔt for one interval (module docs). Everything
+/// not listed is zero, except the identity block Δt·I of ∂δṙ/∂δv.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transition {
+    /// Interval Δt, s.
+    pub dt_s: f64,
+    /// F_rr Δt.
+    pub rr: M3,
+    /// F_vr Δt.
+    pub vr: M3,
+    /// F_vv Δt.
+    pub vv: M3,
+    /// F_vφ Δt = [f^n×]Δt.
+    pub vphi: M3,
+    /// F_v,ba Δt = C_bn Δt.
+    pub vba: M3,
+    /// F_v,sa Δt = C_bn diag(f^b) Δt.
+    pub vsa: M3,
+    /// F_φr Δt.
+    pub phir: M3,
+    /// F_φv Δt.
+    pub phiv: M3,
+    /// F_φφ Δt = −[ω_in×]Δt.
+    pub phiphi: M3,
+    /// F_φ,bg Δt = −C_bn Δt.
+    pub phibg: M3,
+    /// F_φ,sg Δt = −C_bn diag(ω_ib^b) Δt.
+    pub phisg: M3,
+    /// −Δt/T for the 12 sensor states.
+    pub sensor: [f64; 12],
+}
+
+impl Transition {
+    /// Build A = FΔt at the state `nav` (start of the interval) for the compensated
+    /// mean angular rate `omega_ib_b_rad_s` and specific force `f_b_m_s2` over `dt_s`.
+    /// `neg_inv_tau` from [`FilterConfig::neg_inv_tau`].
+    pub fn new(
+        nav: &NavState,
+        omega_ib_b_rad_s: Vec3,
+        f_b_m_s2: Vec3,
+        dt_s: f64,
+        neg_inv_tau: &[f64; 12],
+    ) -> Transition {
+        let dt = dt_s;
+        let (s, c) = nav.lat_rad.sin_cos();
+        let tan = s / c;
+        let h = nav.height_m;
+        let rm = earth::meridian_radius_m(nav.lat_rad);
+        let rn = earth::prime_vertical_radius_m(nav.lat_rad);
+        let (rm_h, rn_h) = (rm + h, rn + h);
+        let v = nav.vel_ned_m_s;
+        let g = earth::normal_gravity_m_s2(nav.lat_rad, h);
+        let w = earth::OMEGA_IE;
+        let w_ie = [w * c, 0.0, -w * s];
+        let w_en = [v[1] / rn_h, -v[0] / rm_h, -v[1] * tan / rn_h];
+        let w_in = add(w_ie, w_en);
+        let c_bn = nav.q_bn.to_dcm().0;
+        let f_n = mv(&c_bn, &f_b_m_s2);
+
+        // Jacobians of ω_ie and ω_en with respect to δr = (δr_N, δr_E, δr_D) and δv.
+        let m_ie_r: M3 = [
+            [-w * s / rm_h, 0.0, 0.0],
+            [0.0, 0.0, 0.0],
+            [-w * c / rm_h, 0.0, 0.0],
+        ];
+        let m_en_r: M3 = [
+            [0.0, 0.0, v[1] / (rn_h * rn_h)],
+            [0.0, 0.0, -v[0] / (rm_h * rm_h)],
+            [
+                -v[1] / (c * c * rn_h * rm_h),
+                0.0,
+                -v[1] * tan / (rn_h * rn_h),
+            ],
+        ];
+        let m_en_v: M3 = [
+            [0.0, 1.0 / rn_h, 0.0],
+            [-1.0 / rm_h, 0.0, 0.0],
+            [0.0, -tan / rn_h, 0.0],
+        ];
+        let vx = Mat3::skew(v).0;
+        let rr: M3 = [
+            [-v[2] / rm_h, 0.0, v[0] / rm_h],
+            [
+                v[1] * tan / rm_h,
+                -(v[2] / rn_h + v[0] * tan / rm_h),
+                v[1] / rn_h,
+            ],
+            [0.0, 0.0, 0.0],
+        ];
+        let mut vr = mmul(&vx, &madd(&sm(&m_ie_r, 2.0), &m_en_r));
+        vr[2][2] += 2.0 * g / ((rm * rn).sqrt() + h);
+        let w2 = add(scale(w_ie, 2.0), w_en);
+        let vv = madd(&mmul(&vx, &m_en_v), &sm(&Mat3::skew(w2).0, -1.0));
+        let vphi = Mat3::skew(f_n).0;
+        let mut vsa = c_bn;
+        let mut phisg = c_bn;
+        for row in 0..3 {
+            for col in 0..3 {
+                vsa[row][col] *= f_b_m_s2[col];
+                phisg[row][col] *= -omega_ib_b_rad_s[col];
+            }
+        }
+        Transition {
+            dt_s: dt,
+            rr: sm(&rr, dt),
+            vr: sm(&vr, dt),
+            vv: sm(&vv, dt),
+            vphi: sm(&vphi, dt),
+            vba: sm(&c_bn, dt),
+            vsa: sm(&vsa, dt),
+            phir: sm(&madd(&m_ie_r, &m_en_r), dt),
+            phiv: sm(&m_en_v, dt),
+            phiphi: sm(&Mat3::skew(w_in).0, -dt),
+            phibg: sm(&c_bn, -dt),
+            phisg: sm(&phisg, dt),
+            sensor: neg_inv_tau.map(|k| k * dt),
+        }
+    }
+
+    /// y = A x (A = Φ − I), exploiting the block structure.
+    #[inline(always)]
+    pub fn apply(&self, x: &[f64; N_STATES]) -> [f64; N_STATES] {
+        let mut y = [0.0; N_STATES];
+        let xr = &x[POS..POS + 3];
+        let xv = &x[VEL..VEL + 3];
+        let xp = &x[ATT..ATT + 3];
+        let a = mv(&self.rr, xr);
+        for k in 0..3 {
+            y[POS + k] = a[k] + self.dt_s * xv[k];
+        }
+        let a = mv(&self.vr, xr);
+        let b = mv(&self.vv, xv);
+        let c = mv(&self.vphi, xp);
+        let d = mv(&self.vba, &x[BA..BA + 3]);
+        let e = mv(&self.vsa, &x[SA..SA + 3]);
+        for k in 0..3 {
+            y[VEL + k] = a[k] + b[k] + c[k] + d[k] + e[k];
+        }
+        let a = mv(&self.phir, xr);
+        let b = mv(&self.phiv, xv);
+        let c = mv(&self.phiphi, xp);
+        let d = mv(&self.phibg, &x[BG..BG + 3]);
+        let e = mv(&self.phisg, &x[SG..SG + 3]);
+        for k in 0..3 {
+            y[ATT + k] = a[k] + b[k] + c[k] + d[k] + e[k];
+        }
+        for k in 0..12 {
+            y[BG + k] = self.sensor[k] * x[BG + k];
+        }
+        y
+    }
+
+    /// Φ as a dense matrix (for tests and smoothers that want it explicitly).
+    pub fn phi_dense(&self) -> Cov {
+        let mut phi = [[0.0; N_STATES]; N_STATES];
+        for j in 0..N_STATES {
+            let mut e = [0.0; N_STATES];
+            e[j] = 1.0;
+            let col = self.apply(&e);
+            for i in 0..N_STATES {
+                phi[i][j] = col[i] + if i == j { 1.0 } else { 0.0 };
+            }
+        }
+        phi
+    }
+
+    /// The 9 navigation rows of A as a dense 9 × 21 array (sensor rows are diagonal).
+    #[inline]
+    fn nav_rows(&self) -> [[f64; N_STATES]; 9] {
+        let mut a = [[0.0; N_STATES]; 9];
+        for r in 0..3 {
+            for c in 0..3 {
+                a[POS + r][POS + c] = self.rr[r][c];
+                a[VEL + r][POS + c] = self.vr[r][c];
+                a[VEL + r][VEL + c] = self.vv[r][c];
+                a[VEL + r][ATT + c] = self.vphi[r][c];
+                a[VEL + r][BA + c] = self.vba[r][c];
+                a[VEL + r][SA + c] = self.vsa[r][c];
+                a[ATT + r][POS + c] = self.phir[r][c];
+                a[ATT + r][VEL + c] = self.phiv[r][c];
+                a[ATT + r][ATT + c] = self.phiphi[r][c];
+                a[ATT + r][BG + c] = self.phibg[r][c];
+                a[ATT + r][SG + c] = self.phisg[r][c];
+            }
+            a[POS + r][VEL + r] = self.dt_s;
+        }
+        a
+    }
+
+    /// P ← Φ (P + ½Q_cΔt) Φᵀ + ½Q_cΔt with Φ = I + A (module docs), in place.
+    /// `q_c_diag` from [`FilterConfig::q_c_diag`]. Result is exactly symmetric.
+    ///
+    /// Block form with n = the 9 navigation states, s = the 12 sensor states:
+    /// Φ = [[Φ_nn, Φ_ns], [0, E]], E = diag(1 − Δt/T) and
+    ///
+    /// * Z = [Φ_nn Φ_ns] P (9 × 21: the navigation rows of ΦP), as row combinations
+    ///   (axpy over whole 21-element rows of P, zero coefficients skipped);
+    /// * (ΦPΦᵀ)_nn = Z [Φ_nn Φ_ns]ᵀ, as row combinations of Zᵀ (9-element rows);
+    /// * (ΦPΦᵀ)_ns = Z_s E, (ΦPΦᵀ)_ss = E P_ss E (element-wise).
+    ///
+    /// ≈ 90 axpys of length 21 plus 90 of length 9 instead of two dense 21³ products.
+    pub fn propagate(&self, p: &mut Cov, q_c_diag: &[f64; N_STATES]) {
+        let half = 0.5 * self.dt_s;
+        for i in 0..N_STATES {
+            p[i][i] += half * q_c_diag[i];
+        }
+        let a = self.nav_rows();
+        // Z = rows 0..9 of Φ P.
+        let mut z = [[0.0; N_STATES]; 9];
+        for i in 0..9 {
+            let mut acc = p[i];
+            for k in 0..N_STATES {
+                let coef = a[i][k];
+                if coef != 0.0 {
+                    let row = &p[k];
+                    for c in 0..N_STATES {
+                        acc[c] += coef * row[c];
+                    }
+                }
+            }
+            z[i] = acc;
+        }
+        // Zᵀ (21 × 9).
+        let mut zt = [[0.0; 9]; N_STATES];
+        for i in 0..9 {
+            for k in 0..N_STATES {
+                zt[k][i] = z[i][k];
+            }
+        }
+        // (ΦPΦᵀ)_nn, row j = Φ_j · Zᵀ.
+        for j in 0..9 {
+            let mut acc = zt[j];
+            for k in 0..N_STATES {
+                let coef = a[j][k];
+                if coef != 0.0 {
+                    let row = &zt[k];
+                    for c in 0..9 {
+                        acc[c] += coef * row[c];
+                    }
+                }
+            }
+            // acc[i] = (ΦPΦᵀ)[i][j]; keep the upper triangle (i ≤ j) and mirror.
+            for i in 0..=j {
+                p[i][j] = acc[i];
+                p[j][i] = acc[i];
+            }
+        }
+        let e: [f64; 12] = std::array::from_fn(|s| 1.0 + self.sensor[s]);
+        for i in 0..9 {
+            for s in 0..12 {
+                let v = z[i][BG + s] * e[s];
+                p[i][BG + s] = v;
+                p[BG + s][i] = v;
+            }
+        }
+        for s in 0..12 {
+            for t in s..12 {
+                let v = p[BG + s][BG + t] * (e[s] * e[t]);
+                p[BG + s][BG + t] = v;
+                p[BG + t][BG + s] = v;
+            }
+        }
+        for i in 0..N_STATES {
+            p[i][i] += half * q_c_diag[i];
+        }
+    }
+}
+
+/// Transport-plus-Earth rate ω_in^n at a state, rad/s.
+pub(crate) fn omega_in(nav: &NavState) -> Vec3 {
+    add(
+        earth::earth_rate_ned(nav.lat_rad),
+        earth::transport_rate_ned(nav.lat_rad, nav.height_m, nav.vel_ned_m_s),
+    )
+}
+
+/// [a×] as a 3 × 3 array.
+pub(crate) fn skew(a: Vec3) -> M3 {
+    Mat3::skew(a).0
+}
+
+#[allow(dead_code)]
+pub(crate) fn cross3(a: Vec3, b: Vec3) -> Vec3 {
+    cross(a, b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nav::attitude::Quat;
+
+    fn cfg() -> FilterConfig {
+        let gm = |s| GaussMarkov {
+            sigma: s,
+            tau_s: 3600.0,
+        };
+        FilterConfig::new(
+            ImuNoise {
+                gyro_arw_rad_sqrt_s: 1e-4,
+                accel_vrw_m_s_sqrt_s: 1e-3,
+                gyro_bias: gm(1e-4),
+                accel_bias: gm(1e-2),
+                gyro_scale: gm(1e-3),
+                accel_scale: gm(1e-3),
+            },
+            [0.0; 3],
+        )
+    }
+
+    /// Noise model → filter noise: white noise, GM σ² = B² + K²T/2, worst axis.
+    #[test]
+    fn noise_from_allan_model() {
+        use crate::allan::fit::{NoiseFit, Term};
+        use crate::allan::noise_model::{ChannelNoise, NoiseModel, Quantity};
+        let t = |v: f64| {
+            Some(Term {
+                value: v,
+                lo: 0.9 * v,
+                hi: 1.1 * v,
+            })
+        };
+        let fit = |n: f64, b: f64, k: f64| NoiseFit {
+            quantization: None,
+            white: t(n),
+            bias_instability: t(b),
+            rate_random_walk: t(k),
+            rate_ramp: None,
+            gauss_markov: None,
+            confidence: 0.683,
+            rms_log10_residual: 0.0,
+            not_detected: Vec::new(),
+            chi2_reduced: 1.0,
+            n_points: 10,
+        };
+        let mut m = NoiseModel::new(None, 200.0, None);
+        m.channels.push(ChannelNoise::new(
+            "gx",
+            Quantity::AngularRate,
+            fit(1e-4, 1e-5, 1e-7),
+            200.0,
+        ));
+        m.channels.push(ChannelNoise::new(
+            "gy",
+            Quantity::AngularRate,
+            fit(2e-4, 1e-5, 1e-7),
+            200.0,
+        ));
+        m.channels.push(ChannelNoise::new(
+            "ax",
+            Quantity::SpecificForce,
+            fit(1e-3, 1e-4, 0.0),
+            200.0,
+        ));
+        let sc = GaussMarkov {
+            sigma: 1e-3,
+            tau_s: 1e4,
+        };
+        let n = ImuNoise::from_noise_model(&m, 1000.0, sc, sc).expect("noise");
+        assert_eq!(n.gyro_arw_rad_sqrt_s, 2e-4);
+        assert_eq!(n.accel_vrw_m_s_sqrt_s, 1e-3);
+        let want = (1e-10f64 + 1e-14 * 500.0).sqrt();
+        assert!((n.gyro_bias.sigma - want).abs() < 1e-18 && n.gyro_bias.tau_s == 1000.0);
+        assert!((n.accel_bias.sigma - 1e-4).abs() < 1e-18);
+        m.channels.pop();
+        assert!(matches!(
+            ImuNoise::from_noise_model(&m, 1000.0, sc, sc),
+            Err(NavError::Config(_))
+        ));
+    }
+
+    /// The sparse propagation equals the dense Φ(P + ½QΔt)Φᵀ + ½QΔt.
+    #[test]
+    fn sparse_propagation_matches_dense() {
+        let c = cfg();
+        let nav = NavState {
+            time_s: 0.0,
+            lat_rad: 0.5,
+            lon_rad: 1.0,
+            height_m: 100.0,
+            vel_ned_m_s: [10.0, -5.0, 0.3],
+            q_bn: Quat::from_rotation_vector([0.1, -0.2, 2.0]),
+        };
+        let t = Transition::new(
+            &nav,
+            [0.1, -0.05, 0.3],
+            [1.0, 0.5, -9.7],
+            0.005,
+            &c.neg_inv_tau(),
+        );
+        let phi = t.phi_dense();
+        let mut p = [[0.0; N_STATES]; N_STATES];
+        for i in 0..N_STATES {
+            for j in 0..N_STATES {
+                p[i][j] = 0.1 * ((i + j) as f64).cos() / (1.0 + (i as f64 - j as f64).abs());
+            }
+            p[i][i] += 2.0;
+        }
+        let q = c.q_c_diag();
+        let mut pq = p;
+        for i in 0..N_STATES {
+            pq[i][i] += 0.0025 * q[i];
+        }
+        let mut dense = [[0.0; N_STATES]; N_STATES];
+        for i in 0..N_STATES {
+            for j in 0..N_STATES {
+                let mut s = 0.0;
+                for k in 0..N_STATES {
+                    for l in 0..N_STATES {
+                        s += phi[i][k] * pq[k][l] * phi[j][l];
+                    }
+                }
+                dense[i][j] = s + if i == j { 0.0025 * q[i] } else { 0.0 };
+            }
+        }
+        t.propagate(&mut p, &q);
+        for i in 0..N_STATES {
+            for j in 0..N_STATES {
+                assert!((p[i][j] - dense[i][j]).abs() < 1e-13, "{i} {j}");
+            }
+        }
+    }
+}
