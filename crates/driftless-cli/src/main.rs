@@ -8,6 +8,7 @@ mod bench_cmd;
 mod convert_cmd;
 mod demo_cmd;
 mod input;
+mod nav_cmd;
 mod output;
 
 use clap::{Parser, Subcommand};
@@ -33,6 +34,8 @@ enum Command {
     Convert(convert_cmd::ConvertArgs),
     /// Speed benchmarks (parse, binary read, exact and fast OADEV) on generated data.
     Bench(bench_cmd::BenchArgs),
+    /// Loosely coupled GNSS/INS on recorded data, with simulated GNSS outages.
+    Nav(nav_cmd::NavArgs),
     /// Simulate an 18-h static six-axis IMU log with known noise, analyse it, compare.
     Demo(demo_cmd::DemoArgs),
 }
@@ -44,6 +47,7 @@ fn main() -> ExitCode {
         Command::Convert(a) => convert_cmd::run(a),
         Command::Demo(a) => demo_cmd::run(a),
         Command::Bench(a) => bench_cmd::run(a),
+        Command::Nav(a) => nav_cmd::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -9,3 +9,4 @@ pub mod filter;
 pub mod mechanization;
 pub mod outage;
 pub mod pipeline;
+pub mod session;

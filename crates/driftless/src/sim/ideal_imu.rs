@@ -15,7 +15,7 @@
 //! for the smooth analytic trajectories here the quadrature error is far below f64
 //! rounding at 200 Hz).
 //!
-//! Analytic trajectories ([`Stationary`], [`ConstantTurn`], [`StraightRun`]) are defined
+//! Analytic trajectories ([`Stationary`], [`ConstantTurn`], [`StraightRun`], [`LandVehicle`]) are defined
 //! by a path in *scaled local coordinates* (n, e, d)(t) about an origin (φ₀, λ₀, h₀):
 //! φ = φ₀ + n/(R_M(φ₀) + h₀), λ = λ₀ + e/((R_N(φ₀) + h₀)cos φ₀), h = h₀ − d. Position is
 //! then exact by definition and the NED velocity and its derivative are the exact time
@@ -325,6 +325,207 @@ impl Trajectory for StraightRun {
         }
         .to_dcm();
         o.point(scale(u, s), scale(u, sd), scale(u, sdd), c_bn, [0.0; 3])
+    }
+}
+
+/// One piece of a [`LandVehicle`] drive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DriveSegment {
+    /// Standing still for `duration_s`.
+    Stop {
+        /// Duration, s.
+        duration_s: f64,
+    },
+    /// Straight, changing speed from the current value to `to_m_s` with the smooth
+    /// profile v(τ) = v₀ + ½Δv(1 − cos(πτ/T)) (acceleration ½Δv(π/T) sin(πτ/T), zero at
+    /// both ends, so the specific force is continuous); Δv = 0 is a constant-speed run.
+    Speed {
+        /// Speed at the end, m/s (≥ 0).
+        to_m_s: f64,
+        /// Duration T, s.
+        duration_s: f64,
+    },
+    /// Turn at the current (constant) speed through `angle_rad` (positive right) at
+    /// the constant yaw rate angle/T: a circular arc of radius V·T/angle.
+    Turn {
+        /// Heading change, rad.
+        angle_rad: f64,
+        /// Duration T, s.
+        duration_s: f64,
+    },
+}
+
+#[derive(Clone, Copy, Debug)]
+struct SegStart {
+    t0: f64,
+    p0: [f64; 2],
+    yaw0: f64,
+    v0: f64,
+    seg: DriveSegment,
+}
+
+/// (d) A level land-vehicle drive composed of [`DriveSegment`]s: stops, straight runs
+/// with smooth speed changes, constant-speed turns, every piece in closed form (local
+/// path in scaled local coordinates as for the other analytic trajectories, so position,
+/// v^n and v̇^n are exact). The *vehicle* frame v (forward, right, down) has yaw ψ(t) and
+/// zero roll/pitch, its velocity is along its x axis (non-holonomic: no side slip, no
+/// vertical velocity, up to the scaled-coordinate approximation: the NED velocity
+/// deviates from the path yaw by ≈ tan φ₀·Δn/R — ≲ 1e-4 rad within a few km of the
+/// origin, a "side slip" ≤ 1.5 mm/s at 15 m/s); the IMU (body b) is mounted with the constant rotation C_vb
+/// (x_v = C_vb x_b), so C_bn = C_vn C_vb and ω_nb^b = C_vbᵀ (0, 0, ψ̇). Before t = 0 the
+/// first segment is extended analytically; after the last one the vehicle keeps its
+/// final speed and heading.
+#[derive(Clone, Debug)]
+pub struct LandVehicle {
+    origin: LocalOrigin,
+    c_vb: Mat3,
+    segs: Vec<SegStart>,
+}
+
+impl LandVehicle {
+    /// Drive starting at (lat, lon, h) with heading `yaw0_rad` and speed `speed0_m_s`.
+    /// Segment durations must be > 0 (non-positive ones are skipped).
+    pub fn new(
+        lat_rad: f64,
+        lon_rad: f64,
+        height_m: f64,
+        yaw0_rad: f64,
+        speed0_m_s: f64,
+        c_vb: Mat3,
+        segments: &[DriveSegment],
+    ) -> LandVehicle {
+        let mut segs = Vec::with_capacity(segments.len());
+        let (mut t, mut p, mut yaw, mut v) = (0.0, [0.0; 2], yaw0_rad, speed0_m_s);
+        for &seg in segments {
+            let st = SegStart {
+                t0: t,
+                p0: p,
+                yaw0: yaw,
+                v0: v,
+                seg,
+            };
+            let dur = match seg {
+                DriveSegment::Stop { duration_s }
+                | DriveSegment::Speed { duration_s, .. }
+                | DriveSegment::Turn { duration_s, .. } => duration_s,
+            };
+            if dur.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                continue;
+            }
+            let (pe, _, _, ye, _, ve) = st.eval(dur);
+            segs.push(st);
+            t += dur;
+            p = pe;
+            yaw = ye;
+            v = ve;
+        }
+        if segs.is_empty() {
+            segs.push(SegStart {
+                t0: 0.0,
+                p0: [0.0; 2],
+                yaw0: yaw0_rad,
+                v0: speed0_m_s,
+                seg: DriveSegment::Stop { duration_s: 1.0 },
+            });
+        }
+        // Tail: constant speed and heading.
+        segs.push(SegStart {
+            t0: t,
+            p0: p,
+            yaw0: yaw,
+            v0: v,
+            seg: DriveSegment::Speed {
+                to_m_s: v,
+                duration_s: f64::INFINITY,
+            },
+        });
+        LandVehicle {
+            origin: LocalOrigin::new(lat_rad, lon_rad, height_m),
+            c_vb,
+            segs,
+        }
+    }
+
+    /// Total duration of the given segments, s.
+    pub fn duration_s(&self) -> f64 {
+        self.segs.last().map_or(0.0, |s| s.t0)
+    }
+
+    /// Start times (s) of the segments (in the order given, zero-length ones dropped).
+    pub fn segment_starts_s(&self) -> Vec<f64> {
+        self.segs.iter().map(|s| s.t0).collect()
+    }
+}
+
+impl SegStart {
+    /// At τ into the segment: (n, e), (v_n, v_e), (a_n, a_e), ψ, ψ̇, speed.
+    #[allow(clippy::type_complexity)]
+    fn eval(&self, tau: f64) -> ([f64; 2], [f64; 2], [f64; 2], f64, f64, f64) {
+        let (sy, cy) = self.yaw0.sin_cos();
+        match self.seg {
+            DriveSegment::Stop { .. } => (self.p0, [0.0; 2], [0.0; 2], self.yaw0, 0.0, 0.0),
+            DriveSegment::Speed { to_m_s, duration_s } => {
+                let dv = to_m_s - self.v0;
+                let (s, v, a) = if duration_s.is_finite() && dv != 0.0 {
+                    let k = std::f64::consts::PI / duration_s;
+                    let (sn, cs) = (k * tau).sin_cos();
+                    (
+                        self.v0 * tau + 0.5 * dv * (tau - sn / k),
+                        self.v0 + 0.5 * dv * (1.0 - cs),
+                        0.5 * dv * k * sn,
+                    )
+                } else {
+                    (self.v0 * tau, self.v0, 0.0)
+                };
+                (
+                    [self.p0[0] + s * cy, self.p0[1] + s * sy],
+                    [v * cy, v * sy],
+                    [a * cy, a * sy],
+                    self.yaw0,
+                    0.0,
+                    v,
+                )
+            }
+            DriveSegment::Turn {
+                angle_rad,
+                duration_s,
+            } => {
+                let w = angle_rad / duration_s;
+                let v = self.v0;
+                let psi = self.yaw0 + w * tau;
+                let (sp, cp) = psi.sin_cos();
+                let p = if w.abs() > 1e-12 {
+                    let r = v / w;
+                    [self.p0[0] + r * (sp - sy), self.p0[1] + r * (cy - cp)]
+                } else {
+                    [self.p0[0] + v * tau * cy, self.p0[1] + v * tau * sy]
+                };
+                (p, [v * cp, v * sp], [-v * w * sp, v * w * cp], psi, w, v)
+            }
+        }
+    }
+}
+
+impl Trajectory for LandVehicle {
+    fn point(&self, t_s: f64) -> TrajectoryPoint {
+        let i = self.segs.partition_point(|s| s.t0 <= t_s).saturating_sub(1);
+        let sg = &self.segs[i];
+        let (p, v, a, psi, w, _) = sg.eval(t_s - sg.t0);
+        let c_vn = Euler {
+            roll_rad: 0.0,
+            pitch_rad: 0.0,
+            yaw_rad: psi,
+        }
+        .to_dcm();
+        let c_bn = c_vn.mul_mat(&self.c_vb);
+        let omega_nb_b = self.c_vb.t().mul_vec([0.0, 0.0, w]);
+        self.origin.point(
+            [p[0], p[1], 0.0],
+            [v[0], v[1], 0.0],
+            [a[0], a[1], 0.0],
+            c_bn,
+            omega_nb_b,
+        )
     }
 }
 

@@ -35,7 +35,7 @@
 //! quaternion of the rotation vector φ (Groves §14.2.7 with the opposite sign convention
 //! for the error; Shin §3.4).
 
-use driftless_model::linalg::{Mat3, Vec3, cross, sub};
+use driftless_model::linalg::{Mat3, Vec3, add, cross, sub};
 
 use super::NavError;
 use super::model::{FilterConfig, Transition, omega_in, skew};
@@ -54,6 +54,13 @@ pub enum UpdateKind {
     Position,
     /// GNSS antenna velocity.
     Velocity,
+    /// Non-holonomic constraint (lateral and vertical vehicle-frame velocity = 0;
+    /// innovation (y, z, 0)), [`Eskf::update_nhc`].
+    Nhc,
+    /// Zero-velocity update, [`Eskf::update_zupt`].
+    Zupt,
+    /// Zero-angular-rate update, [`Eskf::update_zaru`].
+    Zaru,
 }
 
 /// Result of one measurement update.
@@ -63,7 +70,8 @@ pub struct UpdateOutcome {
     pub kind: UpdateKind,
     /// Epoch, s.
     pub time_s: f64,
-    /// Innovation y (predicted − measured), NED, m or m/s.
+    /// Innovation y (predicted − measured): NED m or m/s for GNSS and ZUPT, body rad/s
+    /// for ZARU, vehicle-frame (lateral, vertical, 0) m/s for NHC.
     pub innovation: Vec3,
     /// Normalized innovation squared yᵀS⁻¹y.
     pub nis: f64,
@@ -261,7 +269,14 @@ impl Eskf {
             }
         }
         const COLS: [usize; 6] = [POS, POS + 1, POS + 2, ATT, ATT + 1, ATT + 2];
-        self.update(UpdateKind::Position, y, &h, &COLS, sigma_ned_m)
+        self.update(
+            UpdateKind::Position,
+            y,
+            &h,
+            &COLS,
+            sigma_ned_m,
+            self.chi2_gate,
+        )
     }
 
     /// GNSS velocity update: `v_ned_m_s` the antenna velocity, `sigma_ned_m_s` its σ.
@@ -293,18 +308,156 @@ impl Eskf {
             }
         }
         const COLS: [usize; 12] = [3, 4, 5, 6, 7, 8, 9, 10, 11, 15, 16, 17];
-        self.update(UpdateKind::Velocity, y, &h, &COLS, sigma_ned_m_s)
+        self.update(
+            UpdateKind::Velocity,
+            y,
+            &h,
+            &COLS,
+            sigma_ned_m_s,
+            self.chi2_gate,
+        )
     }
 
-    /// Generic 3-dimensional update with H non-zero only in `cols`, R = diag(σ²).
-    fn update(
+    /// Non-holonomic constraint (land vehicle): the velocity of the wheel-contact /
+    /// rear-axle point at lever arm `lever_b_m` (body axes, from the IMU) resolved in the
+    /// vehicle frame has zero lateral and vertical components (Shin 2001; Dissanayake et
+    /// al. 2001; Groves 2013 §16.4.1):
+    ///
+    ///   v^v = C_vb (C_nb v^n + ω_nb^b × l),  ω_nb^b = ω_ib^b − C_nb ω_in^n,
+    ///   z = (v^v_y, v^v_z) = 0 with R = diag(σ_y², σ_z²),
+    ///
+    /// `c_vb` the IMU-to-vehicle rotation (x_v = C_vb x_b). With Ĉ_nb = C_nb(I + [φ×])
+    /// (error convention of [`super`]), Ĉ_nb v̂ = C_nb v + C_nb δv − C_nb[v×]φ, and
+    /// ω̂_ib × l = ω_ib × l − [l×](b_g + diag(ω̂)s_g), so y = ẑ − 0 = H δx + noise with
+    /// rows y and z of
+    ///
+    ///   H_δv = C_vb Ĉ_nb,  H_φ = −C_vb Ĉ_nb [v̂^n×],
+    ///   H_bg = −C_vb [l×],  H_sg = −C_vb [l×] diag(ω̂_ib^b)
+    ///
+    /// (the error of C_nb ω_in^n, ≤ 1e-4·|φ|, is neglected in H and kept in ẑ). ω̂_ib^b is
+    /// the compensated rate of the last prediction interval.
+    pub fn update_nhc(
+        &mut self,
+        c_vb: &Mat3,
+        lever_b_m: Vec3,
+        sigma_m_s: [f64; 2],
+        gate: Option<f64>,
+    ) -> Result<UpdateOutcome, NavError> {
+        let t = self.nav.time_s;
+        let sig3 = [sigma_m_s[0], sigma_m_s[1], 1.0];
+        check_meas(t, &[0.0; 3], &sig3, &lever_b_m)?;
+        let c_nb = self.nav.q_bn.to_dcm().t();
+        let a = c_vb.mul_mat(&c_nb);
+        let w = self.last_omega_b_rad_s;
+        let w_nb = sub(w, c_nb.mul_vec(omega_in(&self.nav)));
+        let v_b = add(c_nb.mul_vec(self.nav.vel_ned_m_s), cross(w_nb, lever_b_m));
+        let v_v = c_vb.mul_vec(v_b);
+        let h_att = (a * Mat3::skew(self.nav.vel_ned_m_s)).0;
+        let c_lx = (*c_vb * Mat3::skew(lever_b_m)).0;
+        let mut h = [[0.0; N_STATES]; 2];
+        for (m, row) in h.iter_mut().enumerate() {
+            let r = m + 1;
+            for k in 0..3 {
+                row[VEL + k] = a.0[r][k];
+                row[ATT + k] = -h_att[r][k];
+                row[BG + k] = -c_lx[r][k];
+                row[SG + k] = -c_lx[r][k] * w[k];
+            }
+        }
+        const COLS_L: [usize; 12] = [3, 4, 5, 6, 7, 8, 9, 10, 11, 15, 16, 17];
+        let cols: &[usize] = if lever_b_m == [0.0; 3] {
+            &COLS_L[..6]
+        } else {
+            &COLS_L
+        };
+        self.update(UpdateKind::Nhc, [v_v[1], v_v[2]], &h, cols, sigma_m_s, gate)
+    }
+
+    /// Zero-velocity update at standstill: z = v^n = 0 (the IMU at rest), y = v̂^n,
+    /// H = [0, I₃, 0, …], R = σ²I (Groves 2013 §16.2.3; Shin 2005 ch. 5).
+    pub fn update_zupt(
+        &mut self,
+        sigma_m_s: f64,
+        gate: Option<f64>,
+    ) -> Result<UpdateOutcome, NavError> {
+        let t = self.nav.time_s;
+        check_meas(t, &[0.0; 3], &[sigma_m_s; 3], &[0.0; 3])?;
+        let mut h = [[0.0; N_STATES]; 3];
+        for (m, row) in h.iter_mut().enumerate() {
+            row[VEL + m] = 1.0;
+        }
+        const COLS: [usize; 3] = [VEL, VEL + 1, VEL + 2];
+        let y = self.nav.vel_ned_m_s;
+        self.update(UpdateKind::Zupt, y, &h, &COLS, [sigma_m_s; 3], gate)
+    }
+
+    /// Zero-angular-rate update at standstill (Groves 2013 §16.2.3): the body does not
+    /// rotate relative to the Earth, ω_ib^b − C_nb ω_ie^n = 0. The measurement is the
+    /// mean compensated rate over a stretch of standstill given by its *raw* angle
+    /// increment `raw_dtheta_rad` over `dt_s` (compensated here with the current
+    /// estimates: ω̂ = (Δθ̃/Δt − b̂_g) ⊘ (1 + ŝ_g)); y = ω̂ − Ĉ_nb ω_ie^n. With
+    /// ω̂ = ω + b_g + diag(ω)s_g and Ĉ_nb ω_ie = C_nb ω_ie − C_nb[ω_ie×]φ:
+    ///
+    ///   H_bg = I₃,  H_sg = diag(ω̂),  H_φ = Ĉ_nb [ω_ie^n×],
+    ///
+    /// so ZARU observes the gyro biases directly — including the vertical one, which a
+    /// ZUPT (or GNSS at rest) cannot — and stops the heading drift at rest. `sigma_rad_s`
+    /// is the σ of that mean rate (white gyro noise ARW/√Δt plus vibration).
+    pub fn update_zaru(
+        &mut self,
+        raw_dtheta_rad: Vec3,
+        dt_s: f64,
+        sigma_rad_s: f64,
+        gate: Option<f64>,
+    ) -> Result<UpdateOutcome, NavError> {
+        let t = self.nav.time_s;
+        check_meas(t, &raw_dtheta_rad, &[sigma_rad_s; 3], &[0.0; 3])?;
+        if !(dt_s.is_finite() && dt_s > 0.0) {
+            return Err(NavError::InvalidMeasurement {
+                time_s: t,
+                reason: format!("ZARU interval {dt_s} s must be > 0"),
+            });
+        }
+        let s = &self.sensors;
+        let w: Vec3 = std::array::from_fn(|k| {
+            (raw_dtheta_rad[k] / dt_s - s.gyro_bias_rad_s[k]) / (1.0 + s.gyro_scale[k])
+        });
+        let c_nb = self.nav.q_bn.to_dcm().t();
+        let w_ie = earth::earth_rate_ned(self.nav.lat_rad);
+        let y = sub(w, c_nb.mul_vec(w_ie));
+        let h_att = (c_nb * Mat3::skew(w_ie)).0;
+        let mut h = [[0.0; N_STATES]; 3];
+        for (m, row) in h.iter_mut().enumerate() {
+            row[BG + m] = 1.0;
+            row[SG + m] = w[m];
+            row[ATT..ATT + 3].copy_from_slice(&h_att[m]);
+        }
+        const COLS: [usize; 9] = [
+            ATT,
+            ATT + 1,
+            ATT + 2,
+            BG,
+            BG + 1,
+            BG + 2,
+            SG,
+            SG + 1,
+            SG + 2,
+        ];
+        self.update(UpdateKind::Zaru, y, &h, &COLS, [sigma_rad_s; 3], gate)
+    }
+
+    /// Generic M-dimensional update (M = 2 or 3) with H non-zero only in `cols`,
+    /// R = diag(σ²), χ² gate `gate` on the NIS.
+    fn update<const M: usize>(
         &mut self,
         kind: UpdateKind,
-        y: Vec3,
-        h: &[[f64; N_STATES]; 3],
+        y: [f64; M],
+        h: &[[f64; N_STATES]; M],
         cols: &[usize],
-        sigma: Vec3,
+        sigma: [f64; M],
+        gate: Option<f64>,
     ) -> Result<UpdateOutcome, NavError> {
+        const { assert!(M >= 1 && M <= 3) };
         let t = self.nav.time_s;
         check_diagonal(&self.p).map_err(|(i, v)| NavError::Covariance {
             time_s: t,
@@ -314,17 +467,22 @@ impl Eskf {
             ),
         })?;
         let p = &self.p;
-        // PHᵀ (21 × 3).
-        let mut pht = [[0.0; 3]; N_STATES];
+        // PHᵀ (21 × M).
+        let mut pht = [[0.0; M]; N_STATES];
         for (i, row) in pht.iter_mut().enumerate() {
             for (m, v) in row.iter_mut().enumerate() {
                 *v = cols.iter().map(|&c| p[i][c] * h[m][c]).sum();
             }
         }
         let r = sigma.map(|s| s * s);
+        // S, padded to 3 × 3 with an identity block (its inverse then carries the
+        // inverse of the M × M block unchanged).
         let mut s = [[0.0; 3]; 3];
-        for m in 0..3 {
-            for n in 0..3 {
+        for m in M..3 {
+            s[m][m] = 1.0;
+        }
+        for m in 0..M {
+            for n in 0..M {
                 s[m][n] = cols.iter().map(|&c| h[m][c] * pht[c][n]).sum::<f64>();
             }
             s[m][m] += r[m];
@@ -341,8 +499,12 @@ impl Eskf {
             time_s: t,
             diagnosis: format!("innovation covariance S = {s:?} is singular"),
         })?;
-        let siy = s_inv.mul_vec(y);
-        let nis = y[0] * siy[0] + y[1] * siy[1] + y[2] * siy[2];
+        let siy: [f64; M] =
+            std::array::from_fn(|m| (0..M).map(|n| s_inv.0[m][n] * y[n]).sum::<f64>());
+        let mut nis = 0.0;
+        for m in 0..M {
+            nis += y[m] * siy[m];
+        }
         if !nis.is_finite() || nis < 0.0 {
             return Err(NavError::Covariance {
                 time_s: t,
@@ -351,11 +513,13 @@ impl Eskf {
                 ),
             });
         }
-        let accepted = self.chi2_gate.is_none_or(|g| nis <= g);
+        let accepted = gate.is_none_or(|g| nis <= g);
+        let mut innovation = [0.0; 3];
+        innovation[..M].copy_from_slice(&y);
         let out = UpdateOutcome {
             kind,
             time_s: t,
-            innovation: y,
+            innovation,
             nis,
             accepted,
         };
@@ -363,24 +527,32 @@ impl Eskf {
             return Ok(out);
         }
         // K = PHᵀS⁻¹, δx = K y.
-        let mut k = [[0.0; 3]; N_STATES];
+        let mut k = [[0.0; M]; N_STATES];
         let mut dx = [0.0; N_STATES];
         for i in 0..N_STATES {
-            for n in 0..3 {
-                k[i][n] = (0..3).map(|m| pht[i][m] * s_inv.0[m][n]).sum();
+            for n in 0..M {
+                k[i][n] = (0..M).map(|m| pht[i][m] * s_inv.0[m][n]).sum();
             }
-            dx[i] = k[i][0] * y[0] + k[i][1] * y[1] + k[i][2] * y[2];
+            let mut a = 0.0;
+            for m in 0..M {
+                a += k[i][m] * y[m];
+            }
+            dx[i] = a;
         }
         // Joseph form: W = (I − KH)P = P − K(PHᵀ)ᵀ; P⁺ = W − (WHᵀ)Kᵀ + K R Kᵀ.
         let mut w = *p;
         for i in 0..N_STATES {
             for j in 0..N_STATES {
-                w[i][j] -= k[i][0] * pht[j][0] + k[i][1] * pht[j][1] + k[i][2] * pht[j][2];
+                let mut a = 0.0;
+                for m in 0..M {
+                    a += k[i][m] * pht[j][m];
+                }
+                w[i][j] -= a;
             }
         }
-        let mut wht = [[0.0; 3]; N_STATES];
+        let mut wht = [[0.0; M]; N_STATES];
         for i in 0..N_STATES {
-            for m in 0..3 {
+            for m in 0..M {
                 wht[i][m] = cols.iter().map(|&c| w[i][c] * h[m][c]).sum();
             }
         }
@@ -388,12 +560,13 @@ impl Eskf {
         for i in 0..N_STATES {
             for j in 0..N_STATES {
                 let mut a = 0.0;
-                for m in 0..3 {
+                for m in 0..M {
                     a += (k[i][m] * r[m] - wht[i][m]) * k[j][m];
                 }
                 pn[i][j] += a;
             }
         }
+
         let prior_diag: [f64; N_STATES] = std::array::from_fn(|i| p[i][i]);
         check_covariance_scaled(&pn, self.symmetry_tol, &prior_diag).map_err(|d| {
             NavError::Covariance {

@@ -9,6 +9,9 @@
 //!   arm, χ² gating, Joseph form, feedback and reset, covariance health checks.
 //! * [`run`]: [`run_forward`], the forward pass over an IMU log and GNSS fixes (IMU
 //!   increment split at GNSS epochs, outage windows) storing what an RTS smoother needs.
+//! * [`aids`]: land-vehicle aids — non-holonomic constraint, standstill detection,
+//!   zero-velocity and zero-angular-rate updates.
+//! * [`smoother`]: the Rauch–Tung–Striebel smoother over a forward run ([`smooth`]).
 //! * [`align`]: static coarse alignment (levelling, gyrocompassing) and heading from GNSS
 //!   velocity.
 //!
@@ -25,18 +28,22 @@
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the matrix equations
 
+pub mod aids;
 pub mod align;
 pub mod eskf;
 pub mod model;
 pub mod run;
+pub mod smoother;
 pub mod state;
 
+pub use aids::{NhcConfig, StandstillConfig, StandstillDetector};
 pub use align::{
     AlignConfig, Alignment, coarse_align_static, heading_from_gnss_velocity, level_static,
 };
 pub use eskf::{Eskf, UpdateKind, UpdateOutcome};
 pub use model::{FilterConfig, GaussMarkov, ImuNoise, QualityScale, Transition};
 pub use run::{EpochRecord, ForwardRun, InitialState, UpdateRecord, run_forward};
+pub use smoother::{SmoothedEpoch, SmoothedRun, smooth, smooth_with_covariances};
 pub use state::{N_STATES, SensorErrors};
 
 /// Errors of the navigation filter, its driver and the alignment.

@@ -211,6 +211,11 @@ pub struct FilterConfig {
     pub max_gap_factor: f64,
     /// Relative asymmetry tolerated in P before it is reported as corrupted.
     pub symmetry_tol: f64,
+    /// Non-holonomic constraint ([`super::aids`]); `None` (default) disables it.
+    pub nhc: Option<super::aids::NhcConfig>,
+    /// Standstill detection with ZUPT / ZARU ([`super::aids`]); `None` (default)
+    /// disables it.
+    pub standstill: Option<super::aids::StandstillConfig>,
 }
 
 /// χ²₀.₉₉₉₉ quantile for 3 degrees of freedom.
@@ -228,6 +233,8 @@ impl FilterConfig {
             outages_s: Vec::new(),
             max_gap_factor: 2.5,
             symmetry_tol: 1e-9,
+            nhc: None,
+            standstill: None,
         }
     }
 
@@ -303,6 +310,12 @@ impl FilterConfig {
                     "outage window ({a}, {b}) is invalid"
                 )));
             }
+        }
+        if let Some(n) = &self.nhc {
+            n.validate()?;
+        }
+        if let Some(s) = &self.standstill {
+            s.validate()?;
         }
         Ok(())
     }

@@ -29,14 +29,27 @@
 //! 1 Hz). Between updates P_{k+1|k} = P_{k+1|k+1}, so the RTS recursion
 //! C_k = P_{k|k} Φ_kᵀ P_{k+1|k}⁻¹ can be run segment by segment (re-propagate a segment
 //! forward into a scratch buffer, then sweep it backwards).
+//!
+//! # Vehicle aids
+//!
+//! With [`FilterConfig::nhc`] / [`FilterConfig::standstill`] set, after the prediction
+//! of each whole IMU epoch the standstill detector takes the compensated sample, and
+//! ZUPT/ZARU (during a declared standstill) and NHC (otherwise) are applied at their
+//! configured intervals ([`super::aids`]). Such an epoch gets an [`UpdateRecord`] like a
+//! GNSS epoch (P before and after all its updates; merged into the GNSS record when a fix
+//! was applied at the same epoch), so `updates` is ordered by strictly increasing
+//! `epoch_index` and the segment-wise RTS recursion above applies unchanged. Memory: one
+//! 3.7 kB record per aided epoch — NHC at 10 Hz adds ≈ 133 MB per hour of driving.
 
-use driftless_model::linalg::Vec3;
+use driftless_model::linalg::{Vec3, norm};
 
 use super::NavError;
-use super::eskf::{Eskf, UpdateOutcome};
+use super::aids::{NhcConfig, StandstillConfig, StandstillDetector};
+use super::eskf::{Eskf, UpdateKind, UpdateOutcome};
 use super::model::{FilterConfig, Transition};
 use super::state::{ATT, BG, Cov, N_STATES, PackedCov, SensorErrors, VEL, pack};
 use crate::io::nav::GnssFixes;
+use crate::nav::earth;
 use crate::nav::mechanization::{ImuIncrement, NavState};
 
 /// Time tolerance for "the fix is at this epoch", s.
@@ -101,14 +114,17 @@ pub struct EpochRecord {
     pub comp: ImuIncrement,
 }
 
-/// One GNSS epoch's updates.
+/// The updates of one epoch: a GNSS epoch's position/velocity updates and/or the
+/// vehicle aids (NHC, ZUPT, ZARU; [`super::aids`]) applied at that epoch — all updates
+/// at one epoch share one record, so `epoch_index` is strictly increasing.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UpdateRecord {
     /// Index into [`ForwardRun::epochs`].
     pub epoch_index: usize,
     /// GNSS time, s.
     pub time_s: f64,
-    /// The position (and velocity, if used) updates with innovation, NIS and gate result.
+    /// The updates (GNSS position, velocity; NHC, ZUPT, ZARU) with innovation, NIS and
+    /// gate result, in the order applied.
     pub outcomes: Vec<UpdateOutcome>,
     /// P before the updates (packed upper triangle).
     pub p_prior: Box<PackedCov>,
@@ -121,7 +137,8 @@ pub struct UpdateRecord {
 pub struct ForwardRun {
     /// One record per prediction step, the first at the initial state.
     pub epochs: Vec<EpochRecord>,
-    /// One record per GNSS epoch used (accepted or rejected).
+    /// One record per GNSS epoch used (accepted or rejected) and per epoch with vehicle
+    /// aids (see [`UpdateRecord`]).
     pub updates: Vec<UpdateRecord>,
     /// Fixes withheld by outage windows.
     pub gnss_withheld: usize,
@@ -131,6 +148,16 @@ pub struct ForwardRun {
     pub gnss_rejected: usize,
     /// Measurements accepted.
     pub gnss_accepted: usize,
+    /// NHC updates accepted ([`super::aids`]).
+    pub nhc_applied: usize,
+    /// ZUPT updates accepted.
+    pub zupt_applied: usize,
+    /// ZARU updates accepted.
+    pub zaru_applied: usize,
+    /// NHC / ZUPT / ZARU updates rejected by their χ² gates (logged in `updates`).
+    pub aids_rejected: usize,
+    /// Detected standstill intervals (start, end), s ([`super::aids`]).
+    pub standstills: Vec<(f64, f64)>,
     /// −1/T of the sensor states (to rebuild Φ).
     neg_inv_tau: [f64; 12],
 }
@@ -217,6 +244,8 @@ struct Ctx<'a> {
     gnss: &'a GnssFixes,
     cfg: &'a FilterConfig,
     run: ForwardRun,
+    /// Time and speed of the latest applied fix with velocity.
+    gnss_speed: Option<(f64, f64)>,
 }
 
 impl Ctx<'_> {
@@ -237,6 +266,10 @@ impl Ctx<'_> {
             self.cfg.lever_arm_b_m,
         )?;
         outcomes.push(o);
+        if let Some(v) = &gn.vel_ned_m_s {
+            let v = v[g];
+            self.gnss_speed = Some((gn.time_s[g], norm(v)));
+        }
         if self.cfg.use_gnss_velocity
             && let (Some(v), Some(sv)) = (&gn.vel_ned_m_s, &gn.sigma_vel_ned_m_s)
         {
@@ -303,6 +336,7 @@ pub fn run_forward(
     let mut ctx = Ctx {
         gnss,
         cfg,
+        gnss_speed: None,
         run: ForwardRun {
             epochs: Vec::with_capacity(imu.len() - start + gnss.len() + 1),
             updates: Vec::new(),
@@ -310,9 +344,15 @@ pub fn run_forward(
             gnss_skipped: 0,
             gnss_rejected: 0,
             gnss_accepted: 0,
+            nhc_applied: 0,
+            zupt_applied: 0,
+            zaru_applied: 0,
+            aids_rejected: 0,
+            standstills: Vec::new(),
             neg_inv_tau: cfg.neg_inv_tau(),
         },
     };
+    let mut aids = AidState::new(cfg, nominal_dt, t0)?;
     let zero = ImuIncrement {
         time_s: t0,
         dt_s: 0.0,
@@ -403,8 +443,165 @@ pub fn run_forward(
                 .epochs
                 .push(record(&f, f.last_compensated().unwrap_or(rest)));
         }
+        if aids.enabled {
+            let raw = ImuIncrement { dt_s: dt, ..*inc };
+            aids.after_epoch(&mut f, &raw, &mut ctx)?;
+        }
         t_prev = t_end;
     }
     ctx.run.gnss_skipped += ng - g;
+    if let Some(d) = aids.detector {
+        ctx.run.standstills = d.finish();
+    }
     Ok(ctx.run)
+}
+
+/// GNSS speeds older than this do not gate the standstill detector, s.
+const GNSS_SPEED_MAX_AGE_S: f64 = 2.0;
+
+/// Run-time state of the vehicle aids ([`super::aids`]).
+struct AidState {
+    enabled: bool,
+    nhc: Option<NhcConfig>,
+    ss: Option<StandstillConfig>,
+    detector: Option<StandstillDetector>,
+    next_nhc_s: f64,
+    next_zero_s: f64,
+    /// Raw angle increment and time accumulated at standstill since the last ZARU.
+    zaru_dtheta: Vec3,
+    zaru_dt: f64,
+}
+
+impl AidState {
+    fn new(cfg: &FilterConfig, nominal_dt: f64, t0: f64) -> Result<AidState, NavError> {
+        let detector = match &cfg.standstill {
+            Some(s) => Some(StandstillDetector::new(s, nominal_dt)?),
+            None => None,
+        };
+        Ok(AidState {
+            enabled: cfg.nhc.is_some() || cfg.standstill.is_some(),
+            nhc: cfg.nhc,
+            ss: cfg.standstill,
+            detector,
+            next_nhc_s: t0,
+            next_zero_s: t0,
+            zaru_dtheta: [0.0; 3],
+            zaru_dt: 0.0,
+        })
+    }
+
+    /// Detector, ZUPT/ZARU and NHC after the whole IMU epoch ending at `raw.time_s`
+    /// (`raw` the raw increment over the whole epoch).
+    fn after_epoch(
+        &mut self,
+        f: &mut Eskf,
+        raw: &ImuIncrement,
+        ctx: &mut Ctx,
+    ) -> Result<(), NavError> {
+        const EPS: f64 = 1e-9;
+        let t = raw.time_s;
+        let mut outcomes: Vec<UpdateOutcome> = Vec::new();
+        let mut p_prior = None;
+        let mut standstill = false;
+        if let (Some(det), Some(ss)) = (&mut self.detector, &self.ss) {
+            let comp = f.compensate(raw);
+            let inv = 1.0 / raw.dt_s;
+            let nav = f.nav();
+            let speed = norm(nav.vel_ned_m_s);
+            let gate_filter = ss.max_speed_m_s.is_none_or(|v| speed <= v);
+            let gate_gnss = match (ss.gnss_speed_max_m_s, ctx.gnss_speed) {
+                (Some(vmax), Some((tg, v))) if t - tg <= GNSS_SPEED_MAX_AGE_S => v <= vmax,
+                _ => true,
+            };
+            let g = earth::normal_gravity_m_s2(nav.lat_rad, nav.height_m);
+            let c_bn = ss.accel_horizontal_max_m_s2.map(|_| nav.q_bn.to_dcm());
+            standstill = det.push(
+                t,
+                comp.dtheta_rad.map(|v| v * inv),
+                comp.dvel_m_s.map(|v| v * inv),
+                gate_filter && gate_gnss,
+                g,
+                c_bn.as_ref(),
+            );
+            if standstill {
+                for k in 0..3 {
+                    self.zaru_dtheta[k] += raw.dtheta_rad[k];
+                }
+                self.zaru_dt += raw.dt_s;
+                if t >= self.next_zero_s - EPS {
+                    self.next_zero_s = t + ss.interval_s;
+                    p_prior = Some(pack(f.covariance()));
+                    if let Some(s) = ss.zupt_sigma_m_s {
+                        outcomes.push(f.update_zupt(s, ctx.cfg.chi2_gate)?);
+                    }
+                    if let Some(s) = ss.zaru_sigma_rad_s {
+                        outcomes.push(f.update_zaru(
+                            self.zaru_dtheta,
+                            self.zaru_dt,
+                            s,
+                            ctx.cfg.chi2_gate,
+                        )?);
+                    }
+                    self.zaru_dtheta = [0.0; 3];
+                    self.zaru_dt = 0.0;
+                }
+            } else {
+                self.zaru_dtheta = [0.0; 3];
+                self.zaru_dt = 0.0;
+            }
+        }
+        if let Some(nhc) = &self.nhc
+            && !standstill
+            && t >= self.next_nhc_s - EPS
+        {
+            let nav = f.nav();
+            let speed = norm(nav.vel_ned_m_s);
+            // Vehicle yaw rate ≈ z component of C_vb ω̂_ib (Earth rate negligible here).
+            let w_v = nhc.c_vb.mul_vec(f.omega_ib_b_rad_s());
+            if speed >= nhc.min_speed_m_s && w_v[2].abs() <= nhc.max_yaw_rate_rad_s {
+                self.next_nhc_s = t + nhc.interval_s;
+                if p_prior.is_none() {
+                    p_prior = Some(pack(f.covariance()));
+                }
+                outcomes.push(f.update_nhc(
+                    &nhc.c_vb,
+                    nhc.lever_arm_b_m,
+                    nhc.sigma_m_s,
+                    nhc.chi2_gate,
+                )?);
+            }
+        }
+        let Some(p_prior) = p_prior else {
+            return Ok(());
+        };
+        let run = &mut ctx.run;
+        for o in &outcomes {
+            match (o.accepted, o.kind) {
+                (false, _) => run.aids_rejected += 1,
+                (true, UpdateKind::Nhc) => run.nhc_applied += 1,
+                (true, UpdateKind::Zupt) => run.zupt_applied += 1,
+                (true, UpdateKind::Zaru) => run.zaru_applied += 1,
+                (true, _) => {}
+            }
+        }
+        let idx = run.epochs.len() - 1;
+        let comp = run.epochs[idx].comp;
+        run.epochs[idx] = record(f, comp);
+        let p_post = pack(f.covariance());
+        match run.updates.last_mut() {
+            // A GNSS update at this very epoch: merge (prior stays the GNSS prior).
+            Some(u) if u.epoch_index == idx => {
+                u.outcomes.extend(outcomes);
+                u.p_post = p_post;
+            }
+            _ => run.updates.push(UpdateRecord {
+                epoch_index: idx,
+                time_s: t,
+                outcomes,
+                p_prior,
+                p_post,
+            }),
+        }
+        Ok(())
+    }
 }

@@ -1,0 +1,209 @@
+//! `driftless nav`: loosely coupled GNSS/INS on recorded data, with simulated outages.
+//!
+//! Inputs today: KF-GINS increment files or an RTKLIB-tagged IMU CSV (the `drive-0708`
+//! preset sets its units, time shift, mounting and lever arm), and GNSS as RTKLIB `.pos`
+//! or a KF-GINS GNSS file. Output: a summary (full-GNSS accuracy against the fixes,
+//! per-outage errors) and KF-GINS's three output files in `--out`.
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use driftless::io::nav::kfgins::GnssReadOptions;
+use driftless::io::nav::read_kfgins_imu_file;
+use driftless::nav::filter::model::{FilterConfig, GaussMarkov, ImuNoise};
+use driftless::nav::outage::OutageSpec;
+use driftless::nav::pipeline::{
+    GnssOutsideImu, ImuStreamOptions, TaggedCsvOptions, imu_from_kfgins, imu_from_tagged_csv_files,
+    read_gnss_file, select_gnss,
+};
+use driftless::nav::session::{SessionConfig, consumer_mems_noise, run_session, solution_records};
+use std::path::PathBuf;
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ImuFormat {
+    /// KF-GINS increments: time, dθ xyz [rad], dv xyz [m/s].
+    Kfgins,
+    /// RTKLIB-tagged CSV (acc [g], gyro [deg/s], tick [ms]) with a `.tag` file.
+    TaggedCsv,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Preset {
+    /// `shared/data/drive/drive_0708`: tagged CSV, −0.125 s, mounting (180, 0, 180)° plus
+    /// (0, −6.79, 5.35)°, antenna (0, −0.05, 0) m from the IMU, consumer MEMS noise.
+    Drive0708,
+}
+
+#[derive(Args, Debug)]
+pub struct NavArgs {
+    /// IMU file.
+    #[arg(long)]
+    pub imu: PathBuf,
+    /// IMU file format (set by --preset).
+    #[arg(long, value_enum)]
+    pub imu_format: Option<ImuFormat>,
+    /// RTKLIB time-tag file for a tagged CSV (default: IMU path + `.tag`).
+    #[arg(long)]
+    pub tag: Option<PathBuf>,
+    /// GNSS file: RTKLIB `.pos` or KF-GINS GNSS text.
+    #[arg(long)]
+    pub gnss: PathBuf,
+    /// Settings for a known dataset.
+    #[arg(long, value_enum)]
+    pub preset: Option<Preset>,
+    /// Antenna lever arm from the IMU in the body frame, forward,right,down [m].
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub lever_arm: Option<String>,
+    /// IMU noise from an Allan noise-model file (`driftless allan --save-model`); default
+    /// consumer-MEMS values.
+    #[arg(long)]
+    pub noise_model: Option<PathBuf>,
+    /// GNSS outages: `none`, `300+60,600+60` (s after the first fix), `@243600+60`
+    /// (absolute), or `6x60s every 85s from 50s`.
+    #[arg(long, default_value = "none")]
+    pub outages: String,
+    /// Folder for KF-GINS-format output files.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Machine-readable summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_vec3(s: &str, what: &str) -> Result<[f64; 3]> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{what} {s:?}: expected three comma-separated numbers"))?;
+    match v.as_slice() {
+        [a, b, c] if v.iter().all(|x| x.is_finite()) => Ok([*a, *b, *c]),
+        _ => bail!("{what} {s:?}: expected three finite comma-separated numbers"),
+    }
+}
+
+pub fn run(a: NavArgs) -> Result<()> {
+    let format = match (a.imu_format, a.preset) {
+        (Some(f), _) => f,
+        (None, Some(Preset::Drive0708)) => ImuFormat::TaggedCsv,
+        (None, None) => ImuFormat::Kfgins,
+    };
+    let imu = match format {
+        ImuFormat::Kfgins => {
+            let inc = read_kfgins_imu_file(&a.imu)?;
+            imu_from_kfgins(
+                &inc,
+                &a.imu.display().to_string(),
+                &ImuStreamOptions::default(),
+            )?
+        }
+        ImuFormat::TaggedCsv => {
+            let tag = a.tag.clone().unwrap_or_else(|| {
+                let mut p = a.imu.clone().into_os_string();
+                p.push(".tag");
+                PathBuf::from(p)
+            });
+            let opts = match a.preset {
+                Some(Preset::Drive0708) => TaggedCsvOptions::drive_0708(),
+                None => TaggedCsvOptions::default(),
+            };
+            imu_from_tagged_csv_files(&a.imu, &tag, &opts)?
+        }
+    };
+    let gnss = read_gnss_file(&a.gnss, &GnssReadOptions::default())?;
+    let lever = match (&a.lever_arm, a.preset) {
+        (Some(s), _) => parse_vec3(s, "--lever-arm")?,
+        (None, Some(Preset::Drive0708)) => [0.0, -0.05, 0.0],
+        (None, None) => [0.0, 0.0, 0.0],
+    };
+    let noise = match &a.noise_model {
+        Some(p) => {
+            let m = driftless::allan::noise_model::NoiseModel::load(p)?;
+            let scale = GaussMarkov {
+                sigma: 5e-3,
+                tau_s: 3600.0,
+            };
+            ImuNoise::from_noise_model(&m, 3600.0, scale, scale)?
+        }
+        None => consumer_mems_noise(),
+    };
+    let spec: OutageSpec = a.outages.parse().context("--outages")?;
+    let all = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)?;
+    let windows = select_gnss(&gnss, &imu, &spec, GnssOutsideImu::Drop)?.windows;
+    let mut cfg = SessionConfig::new(FilterConfig::new(noise, lever));
+    cfg.outages = windows;
+    let res = run_session(&imu, &all.fixes, &cfg)?;
+
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let (sol, err, std) = solution_records(&res.run);
+        driftless::io::nav::write_kfgins_outputs(dir, &sol, &err, &std, imu.gps_week.unwrap_or(0))?;
+    }
+    let ends: Vec<f64> = res
+        .outages
+        .iter()
+        .filter_map(|o| o.end_horizontal_m)
+        .collect();
+    let mean_end = (!ends.is_empty()).then(|| ends.iter().sum::<f64>() / ends.len() as f64);
+    if a.json {
+        let v = serde_json::json!({
+            "imu_epochs": imu.len(),
+            "gnss_fixes": all.fixes.time_s.len(),
+            "start_time_s": res.init.nav.time_s,
+            "gnss_accepted": res.run.gnss_accepted,
+            "gnss_rejected": res.run.gnss_rejected,
+            "gnss_withheld": res.run.gnss_withheld,
+            "horizontal_rms_m": res.horizontal_rms_m.map(|r| r.0),
+            "outages": res.outages.iter().map(|o| serde_json::json!({
+                "start_s": o.window.start_s, "end_s": o.window.end_s,
+                "end_horizontal_m": o.end_horizontal_m, "max_horizontal_m": o.max_horizontal_m,
+                "end_vertical_m": o.end_vertical_m,
+            })).collect::<Vec<_>>(),
+            "mean_end_horizontal_m": mean_end,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    println!(
+        "{} IMU epochs, {} GNSS fixes in the IMU span; filter started at {:.2} s (first fix above {} m/s)",
+        imu.len(),
+        all.fixes.time_s.len(),
+        res.init.nav.time_s,
+        cfg.min_speed_m_s
+    );
+    println!(
+        "GNSS: {} accepted, {} rejected by the χ² gate, {} withheld by outages",
+        res.run.gnss_accepted, res.run.gnss_rejected, res.run.gnss_withheld
+    );
+    if let Some((rms, n)) = res.horizontal_rms_m {
+        println!("full-GNSS horizontal one-step prediction error: RMS {rms:.3} m over {n} fixes");
+    }
+    if !res.outages.is_empty() {
+        let mut t = crate::output::Table::new([
+            "outage",
+            "start [s]",
+            "end [s]",
+            "end error [m]",
+            "max [m]",
+        ]);
+        for (i, o) in res.outages.iter().enumerate() {
+            t.row(vec![
+                format!("#{}", i + 1),
+                format!("{:.1}", o.window.start_s),
+                format!("{:.1}", o.window.end_s),
+                o.end_horizontal_m.map_or("–".into(), |v| format!("{v:.2}")),
+                format!("{:.2}", o.max_horizontal_m),
+            ]);
+        }
+        print!("{}", t.render());
+        if let Some(m) = mean_end {
+            println!(
+                "mean end-of-outage horizontal error {m:.2} m over {} outages",
+                ends.len()
+            );
+        }
+    }
+    if let Some(dir) = &a.out {
+        println!("KF-GINS-format outputs written to {}", dir.display());
+    }
+    Ok(())
+}

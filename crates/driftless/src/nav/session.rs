@@ -1,0 +1,405 @@
+//! One navigation job on recorded data: initialise in motion, run the forward filter with
+//! GNSS outages, and evaluate against the reference fixes.
+//!
+//! * **Initialisation** (issue 3 deliverable 4, in-motion variant): the gyro biases are
+//!   primed from the mean angular rate of a static stretch at the start of the log (when
+//!   the IMU is static there — |f̄| ≈ g and a small rate spread; the Earth rate, ≤ 15 deg/h,
+//!   is left in the estimate and absorbed by the filter). The filter starts at the first
+//!   GNSS epoch with a velocity and a horizontal speed above `min_speed_m_s`: heading from
+//!   the course over ground, pitch from the climb angle, roll 0 (a land vehicle without
+//!   sideslip, IMU axes already rotated into the vehicle frame), position from the fix
+//!   moved from the antenna to the IMU by the lever arm, velocity from GNSS.
+//! * **Evaluation**: the reference is the GNSS fixes themselves (on `drive_0708` an RTK
+//!   solution, cm level). The full-GNSS accuracy is the one-step prediction error at each
+//!   accepted fix — the horizontal innovation, i.e. the filter's antenna position *before*
+//!   it sees the fix vs the fix — which is stricter than comparing the updated solution.
+//!   For each outage window, the end-of-outage error is the horizontal innovation of the
+//!   first fix after the window, and the maximum error inside it compares the antenna
+//!   position at every IMU epoch with the reference interpolated linearly between fixes.
+
+use super::attitude::Euler;
+use super::earth::{meridian_radius_m, ned_offset_m, prime_vertical_radius_m};
+use super::filter::NavError;
+use super::filter::eskf::UpdateKind;
+use super::filter::model::FilterConfig;
+use super::filter::run::{ForwardRun, InitialState, run_forward};
+use super::filter::state::SensorErrors;
+use super::mechanization::NavState;
+use super::outage::OutageWindow;
+use super::pipeline::ImuStream;
+use crate::io::nav::GnssFixes;
+use driftless_model::linalg::{Vec3, add, norm, scale};
+
+/// Settings of a session beyond the filter's own.
+#[derive(Clone, Debug)]
+pub struct SessionConfig {
+    /// The filter (noise, lever arm, gating …); its `outages_s` is overwritten from `outages`.
+    pub filter: FilterConfig,
+    /// GNSS outage windows, absolute GNSS times.
+    pub outages: Vec<OutageWindow>,
+    /// Horizontal speed needed to take the heading from GNSS velocity, m/s.
+    pub min_speed_m_s: f64,
+    /// Length of the static stretch at the start used to prime the gyro biases, s (0 = off).
+    pub static_prime_s: f64,
+    /// Time after the start excluded from the full-GNSS accuracy figure, s.
+    pub converge_s: f64,
+    /// Time after each outage excluded from the full-GNSS accuracy figure, s.
+    pub reconverge_s: f64,
+}
+
+impl SessionConfig {
+    /// Defaults around a filter configuration.
+    pub fn new(filter: FilterConfig) -> SessionConfig {
+        SessionConfig {
+            filter,
+            outages: Vec::new(),
+            min_speed_m_s: 3.0,
+            static_prime_s: 10.0,
+            converge_s: 60.0,
+            reconverge_s: 30.0,
+        }
+    }
+}
+
+/// Errors of one outage window.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OutageResult {
+    /// The window.
+    pub window: OutageWindow,
+    /// Horizontal error at the end of the outage (innovation of the first fix after it), m.
+    pub end_horizontal_m: Option<f64>,
+    /// Largest horizontal error inside the window, m.
+    pub max_horizontal_m: f64,
+    /// Vertical error at the end of the outage, m.
+    pub end_vertical_m: Option<f64>,
+}
+
+/// Result of [`run_session`].
+#[derive(Debug)]
+pub struct SessionResult {
+    /// The forward run.
+    pub run: ForwardRun,
+    /// The initial state used.
+    pub init: InitialState,
+    /// Gyro bias primed from the static start, if it was static.
+    pub primed_gyro_bias_rad_s: Option<Vec3>,
+    /// RMS horizontal one-step prediction error at accepted fixes outside the convergence
+    /// periods, m, and the number of fixes it covers.
+    pub horizontal_rms_m: Option<(f64, usize)>,
+    /// Per-outage errors.
+    pub outages: Vec<OutageResult>,
+}
+
+/// Run the forward filter on `imu` and `gnss` and evaluate it.
+pub fn run_session(
+    imu: &ImuStream,
+    gnss: &GnssFixes,
+    cfg: &SessionConfig,
+) -> Result<SessionResult, NavError> {
+    let primed = if cfg.static_prime_s > 0.0 {
+        prime_gyro_bias(imu, cfg.static_prime_s)
+    } else {
+        None
+    };
+    let init = initialise_in_motion(imu, gnss, cfg, primed)?;
+    let mut fcfg = cfg.filter.clone();
+    fcfg.outages_s = cfg.outages.iter().map(|w| (w.start_s, w.end_s)).collect();
+    let run = run_forward(&imu.epochs, gnss, init, &fcfg)?;
+
+    // Full-GNSS accuracy: prior innovations at accepted position fixes.
+    let t0 = init.nav.time_s;
+    let excluded = |t: f64| {
+        t < t0 + cfg.converge_s
+            || cfg
+                .outages
+                .iter()
+                .any(|w| t >= w.start_s && t <= w.end_s + cfg.reconverge_s)
+    };
+    let mut sum2 = 0.0;
+    let mut count = 0usize;
+    for u in &run.updates {
+        for o in &u.outcomes {
+            if o.kind == UpdateKind::Position && o.accepted && !excluded(o.time_s) {
+                sum2 += o.innovation[0].powi(2) + o.innovation[1].powi(2);
+                count += 1;
+            }
+        }
+    }
+    let horizontal_rms_m = (count > 0).then(|| ((sum2 / count as f64).sqrt(), count));
+
+    let lever = fcfg.lever_arm_b_m;
+    let outages = cfg
+        .outages
+        .iter()
+        .map(|w| outage_errors(&run, gnss, *w, lever))
+        .collect();
+    Ok(SessionResult {
+        run,
+        init,
+        primed_gyro_bias_rad_s: primed,
+        horizontal_rms_m,
+        outages,
+    })
+}
+
+/// Mean angular rate over the first `seconds` of the log when it is static there:
+/// |mean f| within 0.3 m/s² of 9.8 and every 1-s mean rate within 0.02 rad/s of the total
+/// mean. `None` otherwise.
+pub fn prime_gyro_bias(imu: &ImuStream, seconds: f64) -> Option<Vec3> {
+    let first = imu.epochs.first()?;
+    let t_end = first.time_s + seconds;
+    let win: Vec<_> = imu
+        .epochs
+        .iter()
+        .take_while(|e| e.time_s <= t_end)
+        .collect();
+    let total_t: f64 = win.iter().map(|e| e.dt_s).sum();
+    if win.len() < 10 || total_t < 0.5 * seconds {
+        return None;
+    }
+    let mut dth = [0.0; 3];
+    let mut dv = [0.0; 3];
+    for e in &win {
+        dth = add(dth, e.dtheta_rad);
+        dv = add(dv, e.dvel_m_s);
+    }
+    let w = scale(dth, 1.0 / total_t);
+    let f = scale(dv, 1.0 / total_t);
+    if (norm(f) - 9.8).abs() > 0.3 {
+        return None;
+    }
+    // Rate steadiness: 1-s block means stay near the overall mean.
+    let mut block = [0.0; 3];
+    let mut bt = 0.0;
+    for e in &win {
+        block = add(block, e.dtheta_rad);
+        bt += e.dt_s;
+        if bt >= 1.0 {
+            let m = scale(block, 1.0 / bt);
+            if (0..3).any(|k| (m[k] - w[k]).abs() > 0.02) {
+                return None;
+            }
+            block = [0.0; 3];
+            bt = 0.0;
+        }
+    }
+    Some(w)
+}
+
+/// Initial state at the first GNSS epoch with velocity and enough speed (see module docs).
+pub fn initialise_in_motion(
+    imu: &ImuStream,
+    gnss: &GnssFixes,
+    cfg: &SessionConfig,
+    primed_gyro_bias: Option<Vec3>,
+) -> Result<InitialState, NavError> {
+    let vel = gnss.vel_ned_m_s.as_ref().ok_or_else(|| {
+        NavError::Config(
+            "in-motion initialisation needs GNSS velocity (e.g. RTKLIB .pos with vn/ve/vu)".into(),
+        )
+    })?;
+    let imu_start = imu
+        .epochs
+        .first()
+        .map(|e| e.time_s)
+        .unwrap_or(f64::INFINITY);
+    let imu_end = imu
+        .epochs
+        .last()
+        .map(|e| e.time_s)
+        .unwrap_or(f64::NEG_INFINITY);
+    let in_outage = |t: f64| cfg.outages.iter().any(|w| t >= w.start_s && t <= w.end_s);
+    let i = (0..gnss.time_s.len())
+        .find(|&i| {
+            let t = gnss.time_s[i];
+            let v = vel[i];
+            t > imu_start + 0.05
+                && t < imu_end - 1.0
+                && !in_outage(t)
+                && v[0].hypot(v[1]) > cfg.min_speed_m_s
+        })
+        .ok_or_else(|| {
+            NavError::Config(format!(
+                "no GNSS epoch inside the IMU span with a horizontal speed above {} m/s to \
+                 initialise the heading",
+                cfg.min_speed_m_s
+            ))
+        })?;
+    let v = vel[i];
+    let horiz = v[0].hypot(v[1]);
+    let att = Euler {
+        roll_rad: 0.0,
+        pitch_rad: (-v[2]).atan2(horiz),
+        yaw_rad: v[1].atan2(v[0]),
+    };
+    let q_bn = att.to_quat();
+    // Antenna → IMU: r_imu = r_ant − C_bn·l (NED metres, converted with the local radii).
+    let l_n = q_bn.rotate(cfg.filter.lever_arm_b_m);
+    let (lat_a, lon_a, h_a) = (gnss.lat_rad[i], gnss.lon_rad[i], gnss.height_m[i]);
+    let rm = meridian_radius_m(lat_a) + h_a;
+    let rn = prime_vertical_radius_m(lat_a) + h_a;
+    let nav = NavState {
+        time_s: gnss.time_s[i],
+        lat_rad: lat_a - l_n[0] / rm,
+        lon_rad: lon_a - l_n[1] / (rn * lat_a.cos()),
+        height_m: h_a + l_n[2],
+        vel_ned_m_s: v,
+        q_bn,
+    };
+    let mut sensors = SensorErrors::default();
+    let mut sigma_sensors = None;
+    if let Some(b) = primed_gyro_bias {
+        sensors.gyro_bias_rad_s = b;
+        let n = &cfg.filter.imu;
+        // Primed from ≥ a few seconds of static data: the residual is the Earth rate plus
+        // the short-term drift; keep the other sensor states at their stationary σ.
+        let mut s = [0.0; 12];
+        for k in 0..3 {
+            s[k] = (0.05f64.to_radians()).min(n.gyro_bias.sigma);
+            s[3 + k] = n.accel_bias.sigma;
+            s[6 + k] = n.gyro_scale.sigma;
+            s[9 + k] = n.accel_scale.sigma;
+        }
+        sigma_sensors = Some(s);
+    }
+    let sp = gnss.sigma_ned_m[i];
+    Ok(InitialState {
+        nav,
+        sensors,
+        sigma_pos_ned_m: [sp[0].max(0.05), sp[1].max(0.05), sp[2].max(0.1)],
+        sigma_vel_ned_m_s: [0.1, 0.1, 0.1],
+        sigma_att_rad: [2f64.to_radians(), 2f64.to_radians(), 3f64.to_radians()],
+        sigma_sensors,
+    })
+}
+
+/// Antenna position of a record, (lat, lon, h).
+fn antenna(nav: &NavState, lever_b_m: Vec3) -> (f64, f64, f64) {
+    let l_n = nav.q_bn.rotate(lever_b_m);
+    let rm = meridian_radius_m(nav.lat_rad) + nav.height_m;
+    let rn = prime_vertical_radius_m(nav.lat_rad) + nav.height_m;
+    (
+        nav.lat_rad + l_n[0] / rm,
+        nav.lon_rad + l_n[1] / (rn * nav.lat_rad.cos()),
+        nav.height_m - l_n[2],
+    )
+}
+
+/// Reference position at `t` interpolated linearly between the bracketing fixes.
+fn reference_at(g: &GnssFixes, t: f64) -> Option<(f64, f64, f64)> {
+    let j = g.time_s.partition_point(|&x| x <= t);
+    if j == 0 || j >= g.time_s.len() {
+        return None;
+    }
+    let (t0, t1) = (g.time_s[j - 1], g.time_s[j]);
+    if t1 - t0 > 2.0 {
+        return None;
+    }
+    let a = (t - t0) / (t1 - t0);
+    let lerp = |v: &[f64]| v[j - 1] + a * (v[j] - v[j - 1]);
+    Some((lerp(&g.lat_rad), lerp(&g.lon_rad), lerp(&g.height_m)))
+}
+
+fn outage_errors(run: &ForwardRun, g: &GnssFixes, w: OutageWindow, lever: Vec3) -> OutageResult {
+    let mut max_h = 0.0f64;
+    for e in &run.epochs {
+        let t = e.nav.time_s;
+        if t < w.start_s || t > w.end_s {
+            continue;
+        }
+        if let Some(r) = reference_at(g, t) {
+            let d = ned_offset_m(r, antenna(&e.nav, lever));
+            max_h = max_h.max(d[0].hypot(d[1]));
+        }
+    }
+    let first_after = run
+        .updates
+        .iter()
+        .flat_map(|u| u.outcomes.iter())
+        .find(|o| o.kind == UpdateKind::Position && o.time_s > w.end_s);
+    let (end_h, end_v) = match first_after {
+        Some(o) if o.time_s - w.end_s < 2.0 => (
+            Some(o.innovation[0].hypot(o.innovation[1])),
+            Some(o.innovation[2].abs()),
+        ),
+        _ => (None, None),
+    };
+    OutageResult {
+        window: w,
+        end_horizontal_m: end_h,
+        max_horizontal_m: max_h.max(end_h.unwrap_or(0.0)),
+        end_vertical_m: end_v,
+    }
+}
+
+/// Noise parameters for a consumer MEMS IMU (ICM-4xxxx class, as on `drive_0708`), for
+/// when no Allan noise model of the unit is at hand. White noise from data-sheet densities
+/// of the order of 4 mdeg/s/√Hz and 70 µg/√Hz, doubled for vehicle vibration
+/// (ARW 0.5 deg/√h, VRW 0.08 m/s/√h); uncalibrated turn-on biases up to a few tenths of a
+/// deg/s and tens of mg (the drive's static start shows gyro means up to 0.17 deg/s),
+/// modelled as Gauss–Markov with 1 h correlation; scale-factor errors 0.5 % (1 h).
+pub fn consumer_mems_noise() -> super::filter::model::ImuNoise {
+    use super::filter::model::{GaussMarkov, ImuNoise};
+    use driftless_model::units::{DEG, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H, MILLI_G};
+    ImuNoise {
+        gyro_arw_rad_sqrt_s: 0.5 * DEG_PER_SQRT_H,
+        accel_vrw_m_s_sqrt_s: 0.08 * M_PER_S_PER_SQRT_H,
+        gyro_bias: GaussMarkov {
+            sigma: 0.3 * DEG,
+            tau_s: 3600.0,
+        },
+        accel_bias: GaussMarkov {
+            sigma: 30.0 * MILLI_G,
+            tau_s: 3600.0,
+        },
+        gyro_scale: GaussMarkov {
+            sigma: 5e-3,
+            tau_s: 3600.0,
+        },
+        accel_scale: GaussMarkov {
+            sigma: 5e-3,
+            tau_s: 3600.0,
+        },
+    }
+}
+
+/// The forward run as KF-GINS-style output records (navigation solution, IMU errors,
+/// state standard deviations), one row per IMU epoch.
+pub fn solution_records(
+    run: &ForwardRun,
+) -> (
+    crate::io::nav::NavSolution,
+    crate::io::nav::ImuErrors,
+    crate::io::nav::NavStd,
+) {
+    use super::filter::state::{ATT, BA, BG, POS, SA, SG, VEL};
+    let mut sol = crate::io::nav::NavSolution::default();
+    let mut err = crate::io::nav::ImuErrors::default();
+    let mut std = crate::io::nav::NavStd::default();
+    let tri = |s: &[f64], i: usize| [s[i], s[i + 1], s[i + 2]];
+    for e in &run.epochs {
+        let n = &e.nav;
+        let att = Euler::from_dcm(&n.q_bn.to_dcm());
+        sol.time_s.push(n.time_s);
+        sol.lat_rad.push(n.lat_rad);
+        sol.lon_rad.push(n.lon_rad);
+        sol.height_m.push(n.height_m);
+        sol.vel_ned_m_s.push(n.vel_ned_m_s);
+        sol.roll_pitch_yaw_rad
+            .push([att.roll_rad, att.pitch_rad, att.yaw_rad]);
+        err.time_s.push(n.time_s);
+        err.gyro_bias_rad_s.push(e.sensors.gyro_bias_rad_s);
+        err.accel_bias_m_s2.push(e.sensors.accel_bias_m_s2);
+        err.gyro_scale.push(e.sensors.gyro_scale);
+        err.accel_scale.push(e.sensors.accel_scale);
+        std.time_s.push(n.time_s);
+        std.pos_ned_m.push(tri(&e.std, POS));
+        std.vel_ned_m_s.push(tri(&e.std, VEL));
+        std.att_rad.push(tri(&e.std, ATT));
+        std.gyro_bias_rad_s.push(tri(&e.std, BG));
+        std.accel_bias_m_s2.push(tri(&e.std, BA));
+        std.gyro_scale.push(tri(&e.std, SG));
+        std.accel_scale.push(tri(&e.std, SA));
+    }
+    (sol, err, std)
+}
