@@ -64,6 +64,10 @@ pub struct NavArgs {
     /// Folder for KF-GINS-format output files.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Also run the RTS smoother and report its in-outage errors (on by default with
+    /// `--preset drive0708`).
+    #[arg(long)]
+    pub smooth: bool,
     /// Machine-readable summary.
     #[arg(long)]
     pub json: bool,
@@ -129,7 +133,17 @@ pub fn run(a: NavArgs) -> Result<()> {
     let spec: OutageSpec = a.outages.parse().context("--outages")?;
     let all = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)?;
     let windows = select_gnss(&gnss, &imu, &spec, GnssOutsideImu::Drop)?.windows;
-    let mut cfg = SessionConfig::new(FilterConfig::new(noise, lever));
+    let mut cfg = match a.preset {
+        Some(Preset::Drive0708) => SessionConfig::drive_0708(),
+        None => SessionConfig::new(FilterConfig::new(noise, lever)),
+    };
+    if a.preset.is_some() {
+        if a.noise_model.is_some() {
+            cfg.filter.imu = noise;
+        }
+        cfg.filter.lever_arm_b_m = lever;
+    }
+    cfg.smooth |= a.smooth;
     cfg.outages = windows;
     let res = run_session(&imu, &all.fixes, &cfg)?;
 
@@ -159,6 +173,10 @@ pub fn run(a: NavArgs) -> Result<()> {
                 "end_vertical_m": o.end_vertical_m,
             })).collect::<Vec<_>>(),
             "mean_end_horizontal_m": mean_end,
+            "smoothed_outages": res.smoothed_outages.as_ref().map(|v| v.iter().map(|o| serde_json::json!({
+                "start_s": o.window.start_s, "end_s": o.window.end_s,
+                "end_horizontal_m": o.end_horizontal_m, "max_horizontal_m": o.max_horizontal_m,
+            })).collect::<Vec<_>>()),
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
@@ -183,15 +201,22 @@ pub fn run(a: NavArgs) -> Result<()> {
             "start [s]",
             "end [s]",
             "end error [m]",
-            "max [m]",
+            "max inside [m]",
+            "smoothed max [m]",
         ]);
         for (i, o) in res.outages.iter().enumerate() {
+            let sm = res
+                .smoothed_outages
+                .as_ref()
+                .and_then(|v| v.get(i))
+                .map_or("–".into(), |s| format!("{:.2}", s.max_horizontal_m));
             t.row(vec![
                 format!("#{}", i + 1),
                 format!("{:.1}", o.window.start_s),
                 format!("{:.1}", o.window.end_s),
                 o.end_horizontal_m.map_or("–".into(), |v| format!("{v:.2}")),
                 format!("{:.2}", o.max_horizontal_m),
+                sm,
             ]);
         }
         print!("{}", t.render());

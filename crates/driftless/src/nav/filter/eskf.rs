@@ -94,6 +94,16 @@ pub struct Eskf {
 }
 
 impl Eskf {
+    /// The χ² gate applied to GNSS updates.
+    pub fn chi2_gate(&self) -> Option<f64> {
+        self.chi2_gate
+    }
+
+    /// Replace the χ² gate applied to GNSS updates (`None` = no gating).
+    pub fn set_chi2_gate(&mut self, gate: Option<f64>) {
+        self.chi2_gate = gate;
+    }
+
     /// A filter at `nav` with sensor-error estimates `sensors`, initial covariance
     /// `p0` (checked) and the noise model of `cfg` (validated). `prev_inc` is the raw
     /// increment of the interval before `nav.time_s` (for the two-sample corrections), if

@@ -204,6 +204,13 @@ pub struct FilterConfig {
     pub quality_scale: QualityScale,
     /// Use GNSS velocity (when present) as a second update.
     pub use_gnss_velocity: bool,
+    /// Gate recovery: when no GNSS position fix has been accepted for longer than this
+    /// many seconds (outside outage windows), the next fix is applied without the χ² gate
+    /// (counted in `ForwardRun::gnss_forced`). Without it a transient that pushes the
+    /// innovations past the gate — e.g. RTK σ of 1 cm under-stating the error of a moving
+    /// antenna — makes every later fix look like an outlier and the filter never recovers.
+    /// Isolated outliers (a single 50-m jump) are still rejected. `None` disables.
+    pub gate_recovery_s: Option<f64>,
     /// GNSS outage windows [start, end] (s, inclusive) during which fixes are withheld.
     pub outages_s: Vec<(f64, f64)>,
     /// Largest accepted IMU interval as a multiple of the nominal (first) interval;
@@ -230,6 +237,7 @@ impl FilterConfig {
             chi2_gate: Some(CHI2_3DOF_P9999),
             quality_scale: QualityScale::default(),
             use_gnss_velocity: false,
+            gate_recovery_s: Some(3.0),
             outages_s: Vec::new(),
             max_gap_factor: 2.5,
             symmetry_tol: 1e-9,

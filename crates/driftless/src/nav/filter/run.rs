@@ -146,6 +146,9 @@ pub struct ForwardRun {
     pub gnss_skipped: usize,
     /// Measurements rejected by the χ² gate (each logged in `updates`).
     pub gnss_rejected: usize,
+    /// Position fixes applied without the gate by the gate-recovery rule
+    /// ([`FilterConfig::gate_recovery_s`]).
+    pub gnss_forced: usize,
     /// Measurements accepted.
     pub gnss_accepted: usize,
     /// NHC updates accepted ([`super::aids`]).
@@ -246,6 +249,8 @@ struct Ctx<'a> {
     run: ForwardRun,
     /// Time and speed of the latest applied fix with velocity.
     gnss_speed: Option<(f64, f64)>,
+    /// Time of the latest accepted position fix (the start time before any).
+    last_position_accept_s: f64,
 }
 
 impl Ctx<'_> {
@@ -260,11 +265,32 @@ impl Ctx<'_> {
         let p_prior = pack(f.covariance());
         let mut outcomes = Vec::with_capacity(2);
         let sigma = gn.sigma_ned_m[g].map(|s| s * k);
+        let t_fix = gn.time_s[g];
+        // The recovery clock restarts at the end of the latest outage window.
+        let since = self
+            .cfg
+            .outages_s
+            .iter()
+            .filter(|&&(_, b)| b <= t_fix)
+            .fold(self.last_position_accept_s, |acc, &(_, b)| acc.max(b));
+        let forced = self.cfg.gate_recovery_s.is_some_and(|r| t_fix - since > r);
+        let gate = f.chi2_gate();
+        if forced {
+            f.set_chi2_gate(None);
+        }
         let o = f.update_position(
             [gn.lat_rad[g], gn.lon_rad[g], gn.height_m[g]],
             sigma,
             self.cfg.lever_arm_b_m,
-        )?;
+        );
+        f.set_chi2_gate(gate);
+        let o = o?;
+        if o.accepted {
+            self.last_position_accept_s = t_fix;
+            if forced {
+                self.run.gnss_forced += 1;
+            }
+        }
         outcomes.push(o);
         if let Some(v) = &gn.vel_ned_m_s {
             let v = v[g];
@@ -337,12 +363,14 @@ pub fn run_forward(
         gnss,
         cfg,
         gnss_speed: None,
+        last_position_accept_s: t0,
         run: ForwardRun {
             epochs: Vec::with_capacity(imu.len() - start + gnss.len() + 1),
             updates: Vec::new(),
             gnss_withheld: 0,
             gnss_skipped: 0,
             gnss_rejected: 0,
+            gnss_forced: 0,
             gnss_accepted: 0,
             nhc_applied: 0,
             zupt_applied: 0,
