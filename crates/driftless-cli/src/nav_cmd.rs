@@ -35,9 +35,14 @@ pub enum Preset {
 
 #[derive(Args, Debug)]
 pub struct NavArgs {
+    /// Run a KF-GINS configuration unchanged: its IMU and GNSS files, initial state, noise,
+    /// lever arm and time span; KF-GINS's three output files go to its `outputpath`
+    /// (relative paths resolve against the working directory, as in KF-GINS).
+    #[arg(long, value_name = "CONFIG.yaml", conflicts_with_all = ["imu", "gnss", "preset"])]
+    pub kf_gins: Option<PathBuf>,
     /// IMU file.
-    #[arg(long)]
-    pub imu: PathBuf,
+    #[arg(long, required_unless_present = "kf_gins")]
+    pub imu: Option<PathBuf>,
     /// IMU file format (set by --preset).
     #[arg(long, value_enum)]
     pub imu_format: Option<ImuFormat>,
@@ -45,8 +50,8 @@ pub struct NavArgs {
     #[arg(long)]
     pub tag: Option<PathBuf>,
     /// GNSS file: RTKLIB `.pos` or KF-GINS GNSS text.
-    #[arg(long)]
-    pub gnss: PathBuf,
+    #[arg(long, required_unless_present = "kf_gins")]
+    pub gnss: Option<PathBuf>,
     /// Settings for a known dataset.
     #[arg(long, value_enum)]
     pub preset: Option<Preset>,
@@ -86,6 +91,14 @@ fn parse_vec3(s: &str, what: &str) -> Result<[f64; 3]> {
 }
 
 pub fn run(a: NavArgs) -> Result<()> {
+    if let Some(cfg_path) = &a.kf_gins {
+        return run_kf_gins(cfg_path, &a);
+    }
+    let (Some(imu_path), Some(gnss_path)) = (a.imu.clone(), a.gnss.clone()) else {
+        bail!("--imu and --gnss are required without --kf-gins");
+    };
+    let imu_file = imu_path;
+    let gnss_file = gnss_path;
     let format = match (a.imu_format, a.preset) {
         (Some(f), _) => f,
         (None, Some(Preset::Drive0708)) => ImuFormat::TaggedCsv,
@@ -93,16 +106,16 @@ pub fn run(a: NavArgs) -> Result<()> {
     };
     let imu = match format {
         ImuFormat::Kfgins => {
-            let inc = read_kfgins_imu_file(&a.imu)?;
+            let inc = read_kfgins_imu_file(&imu_file)?;
             imu_from_kfgins(
                 &inc,
-                &a.imu.display().to_string(),
+                &imu_file.display().to_string(),
                 &ImuStreamOptions::default(),
             )?
         }
         ImuFormat::TaggedCsv => {
             let tag = a.tag.clone().unwrap_or_else(|| {
-                let mut p = a.imu.clone().into_os_string();
+                let mut p = imu_file.clone().into_os_string();
                 p.push(".tag");
                 PathBuf::from(p)
             });
@@ -110,10 +123,10 @@ pub fn run(a: NavArgs) -> Result<()> {
                 Some(Preset::Drive0708) => TaggedCsvOptions::drive_0708(),
                 None => TaggedCsvOptions::default(),
             };
-            imu_from_tagged_csv_files(&a.imu, &tag, &opts)?
+            imu_from_tagged_csv_files(&imu_file, &tag, &opts)?
         }
     };
-    let gnss = read_gnss_file(&a.gnss, &GnssReadOptions::default())?;
+    let gnss = read_gnss_file(&gnss_file, &GnssReadOptions::default())?;
     let lever = match (&a.lever_arm, a.preset) {
         (Some(s), _) => parse_vec3(s, "--lever-arm")?,
         (None, Some(Preset::Drive0708)) => [0.0, -0.05, 0.0],
@@ -229,6 +242,124 @@ pub fn run(a: NavArgs) -> Result<()> {
     }
     if let Some(dir) = &a.out {
         println!("KF-GINS-format outputs written to {}", dir.display());
+    }
+    Ok(())
+}
+
+/// `--kf-gins CONFIG`: the KF-GINS job, forward filter only (KF-GINS has no smoother).
+/// KF-GINS gives noise per axis; this filter takes one value per sensor, so the worst
+/// axis is used.
+fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
+    use driftless::io::nav::{KfGinsConfig, read_kfgins_gnss_file};
+    use driftless::nav::attitude::Euler;
+    use driftless::nav::filter::run::{InitialState, run_forward};
+    use driftless::nav::filter::state::SensorErrors;
+    use driftless::nav::mechanization::NavState;
+    let k = KfGinsConfig::from_file(path)?;
+    for key in &k.unknown_keys {
+        eprintln!(
+            "note: {}: key `{key}` is not used by KF-GINS and is ignored",
+            path.display()
+        );
+    }
+    let inc = read_kfgins_imu_file(&k.imu_path)?;
+    let imu = imu_from_kfgins(
+        &inc,
+        &k.imu_path.display().to_string(),
+        &ImuStreamOptions::default(),
+    )?;
+    let gnss = read_kfgins_gnss_file(&k.gnss_path, &GnssReadOptions::default())?;
+    let max3 = |v: [f64; 3]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let n = &k.imu_noise;
+    let gm = |sigma: [f64; 3]| GaussMarkov {
+        sigma: max3(sigma),
+        tau_s: n.corr_time_s,
+    };
+    let noise = ImuNoise {
+        gyro_arw_rad_sqrt_s: max3(n.arw_rad_sqrt_s),
+        accel_vrw_m_s_sqrt_s: max3(n.vrw_m_s_sqrt_s),
+        gyro_bias: gm(n.gyro_bias_std_rad_s),
+        accel_bias: gm(n.accel_bias_std_m_s2),
+        gyro_scale: gm(n.gyro_scale_std),
+        accel_scale: gm(n.accel_scale_std),
+    };
+    let mut cfg = FilterConfig::new(noise, k.antenna_lever_frd_m);
+    let spec: OutageSpec = a.outages.parse().context("--outages")?;
+    if spec != OutageSpec::None {
+        let sel = select_gnss(&gnss, &imu, &spec, GnssOutsideImu::Drop)?;
+        cfg.outages_s = sel.windows.iter().map(|w| (w.start_s, w.end_s)).collect();
+    }
+    let [r, p, y] = k.init_roll_pitch_yaw_rad;
+    let nav = NavState {
+        time_s: k.start_time_s,
+        lat_rad: k.init_lat_rad,
+        lon_rad: k.init_lon_rad,
+        height_m: k.init_height_m,
+        vel_ned_m_s: k.init_vel_ned_m_s,
+        q_bn: Euler {
+            roll_rad: r,
+            pitch_rad: p,
+            yaw_rad: y,
+        }
+        .to_quat(),
+    };
+    let cat = |a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]| {
+        let mut s = [0.0; 12];
+        s[..3].copy_from_slice(&a);
+        s[3..6].copy_from_slice(&b);
+        s[6..9].copy_from_slice(&c);
+        s[9..].copy_from_slice(&d);
+        s
+    };
+    let init = InitialState {
+        nav,
+        sensors: SensorErrors {
+            gyro_bias_rad_s: k.init_gyro_bias_rad_s,
+            accel_bias_m_s2: k.init_accel_bias_m_s2,
+            gyro_scale: k.init_gyro_scale,
+            accel_scale: k.init_accel_scale,
+        },
+        sigma_pos_ned_m: k.init_pos_std_ned_m,
+        sigma_vel_ned_m_s: k.init_vel_std_ned_m_s,
+        sigma_att_rad: k.init_att_std_rad,
+        sigma_sensors: Some(cat(
+            k.init_gyro_bias_std_rad_s,
+            k.init_accel_bias_std_m_s2,
+            k.init_gyro_scale_std,
+            k.init_accel_scale_std,
+        )),
+    };
+    let end = k.end_time_s.unwrap_or(f64::INFINITY);
+    let n_end = imu.epochs.partition_point(|e| e.time_s <= end);
+    let run = run_forward(&imu.epochs[..n_end], &gnss, init, &cfg)?;
+    std::fs::create_dir_all(&k.output_dir)
+        .with_context(|| format!("creating {}", k.output_dir.display()))?;
+    let (sol, err, std) = solution_records(&run);
+    let files = driftless::io::nav::write_kfgins_outputs(&k.output_dir, &sol, &err, &std, 0)?;
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "epochs": run.epochs.len(),
+                "gnss_accepted": run.gnss_accepted,
+                "gnss_rejected": run.gnss_rejected,
+                "gnss_withheld": run.gnss_withheld,
+                "outputs": files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
+            }))?
+        );
+    } else {
+        println!(
+            "{}: {} epochs from {:.3} s, GNSS {} accepted, {} rejected, {} withheld",
+            path.display(),
+            run.epochs.len(),
+            k.start_time_s,
+            run.gnss_accepted,
+            run.gnss_rejected,
+            run.gnss_withheld
+        );
+        for f in &files {
+            println!("wrote {}", f.display());
+        }
     }
     Ok(())
 }

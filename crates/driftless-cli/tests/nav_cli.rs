@@ -1,0 +1,122 @@
+//! `driftless nav --kf-gins`: a KF-GINS job run unchanged on a synthetic KF-GINS dataset
+//! with known truth (ideal increments of a constant-rate turn, exact GNSS fixes with 2 cm
+//! σ labels), checking KF-GINS's output files and the final position.
+
+use driftless::nav::attitude::Euler;
+use driftless::sim::ideal_imu::{ConstantTurn, Trajectory, ideal_increments};
+use std::fmt::Write as _;
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_driftless"))
+}
+
+#[test]
+fn kf_gins_config_runs_unchanged_and_writes_its_three_files() {
+    let dir = std::env::temp_dir().join(format!("driftless-kfgins-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("data")).unwrap();
+    let t0 = 356_400.0; // GPS seconds of week
+    let turn = ConstantTurn {
+        lat_rad: 30.5f64.to_radians(),
+        lon_rad: 114.35f64.to_radians(),
+        height_m: 20.0,
+        speed_m_s: 10.0,
+        yaw0_rad: 0.3,
+        yaw_rate_rad_s: 2f64.to_radians(),
+        roll_rad: 0.0,
+        pitch_rad: 0.0,
+    };
+    let dt = 0.005;
+    let n = 24_000; // 120 s at 200 Hz
+    let mut imu = String::new();
+    for (k, inc) in ideal_increments(&turn, dt, dt, n).enumerate() {
+        let t = t0 + (k + 1) as f64 * dt;
+        writeln!(
+            imu,
+            "{t:.3} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e}",
+            inc.dtheta_rad[0],
+            inc.dtheta_rad[1],
+            inc.dtheta_rad[2],
+            inc.dvel_m_s[0],
+            inc.dvel_m_s[1],
+            inc.dvel_m_s[2]
+        )
+        .unwrap();
+    }
+    let mut gnss = String::new();
+    for s in 1..120 {
+        let p = turn.point(s as f64);
+        writeln!(
+            gnss,
+            "{:.3} {:.10} {:.10} {:.4} 0.02 0.02 0.04",
+            t0 + s as f64,
+            p.lat_rad.to_degrees(),
+            p.lon_rad.to_degrees(),
+            p.height_m
+        )
+        .unwrap();
+    }
+    std::fs::write(dir.join("data/imu.txt"), imu).unwrap();
+    std::fs::write(dir.join("data/gnss.txt"), gnss).unwrap();
+    let p0 = turn.point(0.0);
+    let e0 = Euler::from_dcm(&p0.c_bn);
+    let cfg = format!(
+        "imupath: \"./data/imu.txt\"\ngnsspath: \"./data/gnss.txt\"\noutputpath: \"./out\"\n\
+         imudatalen: 7\nimudatarate: 200\nstarttime: {t0}\nendtime: -1\n\
+         initpos: [{}, {}, {}]\ninitvel: [{}, {}, {}]\ninitatt: [{}, {}, {}]\n\
+         initgyrbias: [0, 0, 0]\ninitaccbias: [0, 0, 0]\ninitgyrscale: [0, 0, 0]\n\
+         initaccscale: [0, 0, 0]\ninitposstd: [0.05, 0.05, 0.05]\ninitvelstd: [0.05, 0.05, 0.05]\n\
+         initattstd: [0.1, 0.1, 0.5]\n\
+         imunoise:\n  arw: [0.2, 0.2, 0.2]\n  vrw: [0.1, 0.1, 0.1]\n  gbstd: [50.0, 50.0, 50.0]\n\
+         \x20 abstd: [1000.0, 1000.0, 1000.0]\n  gsstd: [1000.0, 1000.0, 1000.0]\n\
+         \x20 asstd: [1000.0, 1000.0, 1000.0]\n  corrtime: 1.0\n\
+         antlever: [0.0, 0.0, 0.0]\n",
+        p0.lat_rad.to_degrees(),
+        p0.lon_rad.to_degrees(),
+        p0.height_m,
+        p0.vel_ned_m_s[0],
+        p0.vel_ned_m_s[1],
+        p0.vel_ned_m_s[2],
+        e0.roll_rad.to_degrees(),
+        e0.pitch_rad.to_degrees(),
+        e0.yaw_rad.to_degrees(),
+    );
+    std::fs::write(dir.join("kf-gins.yaml"), cfg).unwrap();
+
+    let out = bin()
+        .current_dir(&dir)
+        .args(["nav", "--kf-gins", "kf-gins.yaml"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "KF_GINS_Navresult.nav",
+        "KF_GINS_IMU_ERR.txt",
+        "KF_GINS_STD.txt",
+    ] {
+        assert!(dir.join("out").join(f).exists(), "{f} missing");
+    }
+    // Last navigation line: week, time, lat, lon, h, vN, vE, vD, roll, pitch, yaw.
+    let nav = std::fs::read_to_string(dir.join("out/KF_GINS_Navresult.nav")).unwrap();
+    let last: Vec<f64> = nav
+        .lines()
+        .last()
+        .unwrap()
+        .split_whitespace()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(last.len(), 11);
+    let t_end = last[1] - t0;
+    assert!((t_end - 120.0).abs() < 0.01, "ends at {t_end} s");
+    let truth = turn.point(t_end);
+    let d_n = (last[2].to_radians() - truth.lat_rad) * 6_378_137.0;
+    let d_e = (last[3].to_radians() - truth.lon_rad) * 6_378_137.0 * truth.lat_rad.cos();
+    let err = d_n.hypot(d_e);
+    eprintln!("--kf-gins: final horizontal error {err:.4} m after 120 s");
+    assert!(err < 0.05, "final horizontal error {err} m");
+    let _ = std::fs::remove_dir_all(&dir);
+}
