@@ -69,6 +69,12 @@ pub struct NavArgs {
     /// Folder for KF-GINS-format output files.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Also write the solution as CSV (time, lat/lon in deg, height, NED velocity, roll/pitch/yaw in deg).
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+    /// Also write the track as GeoJSON (one point per 0.1 s).
+    #[arg(long, value_name = "FILE")]
+    pub geojson: Option<PathBuf>,
     /// Also run the RTS smoother and report its in-outage errors (on by default with
     /// `--preset drive0708`).
     #[arg(long)]
@@ -160,11 +166,12 @@ pub fn run(a: NavArgs) -> Result<()> {
     cfg.outages = windows;
     let res = run_session(&imu, &all.fixes, &cfg)?;
 
+    let (sol, err, std) = solution_records(&res.run);
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        let (sol, err, std) = solution_records(&res.run);
         driftless::io::nav::write_kfgins_outputs(dir, &sol, &err, &std, imu.gps_week.unwrap_or(0))?;
     }
+    write_extra_outputs(&a, &sol, imu.nominal_dt_s)?;
     let ends: Vec<f64> = res
         .outages
         .iter()
@@ -336,6 +343,7 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
         .with_context(|| format!("creating {}", k.output_dir.display()))?;
     let (sol, err, std) = solution_records(&run);
     let files = driftless::io::nav::write_kfgins_outputs(&k.output_dir, &sol, &err, &std, 0)?;
+    write_extra_outputs(a, &sol, imu.nominal_dt_s)?;
     if a.json {
         println!(
             "{}",
@@ -360,6 +368,27 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
         for f in &files {
             println!("wrote {}", f.display());
         }
+    }
+    Ok(())
+}
+
+/// `--csv` and `--geojson`.
+fn write_extra_outputs(
+    a: &NavArgs,
+    sol: &driftless::io::nav::NavSolution,
+    dt_s: f64,
+) -> Result<()> {
+    use driftless::io::nav::track::{write_solution_csv, write_track_geojson};
+    if let Some(p) = &a.csv {
+        write_solution_csv(p, sol)?;
+    }
+    if let Some(p) = &a.geojson {
+        let stride = if dt_s > 0.0 {
+            (0.1 / dt_s).round() as usize
+        } else {
+            1
+        };
+        write_track_geojson(p, sol, stride)?;
     }
     Ok(())
 }

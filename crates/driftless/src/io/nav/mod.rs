@@ -20,6 +20,7 @@ pub mod gpstime;
 pub mod kfgins;
 pub mod kfgins_config;
 pub mod rtklib;
+pub mod track;
 pub mod types;
 
 pub use gpstime::GpsTime;
