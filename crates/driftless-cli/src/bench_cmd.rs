@@ -274,6 +274,81 @@ pub fn run(a: BenchArgs) -> Result<()> {
             med,
             format!("{:.2} µs/epoch", best / n_epochs as f64 * 1e6),
         ));
+        // End to end as KF-GINS is used: its text IMU and GNSS files and YAML in, its
+        // three output files out (`driftless nav --kf-gins`).
+        {
+            use std::fmt::Write as _;
+            let dir = a.dir.join("kfgins");
+            std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+            let mut text = String::with_capacity(incs.len() * 120);
+            for inc in &incs {
+                let _ = writeln!(
+                    text,
+                    "{:.3} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e}",
+                    inc.time_s,
+                    inc.dtheta_rad[0],
+                    inc.dtheta_rad[1],
+                    inc.dtheta_rad[2],
+                    inc.dvel_m_s[0],
+                    inc.dvel_m_s[1],
+                    inc.dvel_m_s[2]
+                );
+            }
+            std::fs::write(dir.join("imu.txt"), &text)?;
+            let imu_mb = text.len() as f64 / 1e6;
+            let mut gt = String::new();
+            for i in 0..g.time_s.len() {
+                let _ = writeln!(
+                    gt,
+                    "{:.3} {:.10} {:.10} {:.4} 0.02 0.02 0.04",
+                    g.time_s[i],
+                    g.lat_rad[i].to_degrees(),
+                    g.lon_rad[i].to_degrees(),
+                    g.height_m[i]
+                );
+            }
+            std::fs::write(dir.join("gnss.txt"), gt)?;
+            let e0 = driftless::nav::attitude::Euler::from_dcm(&start.q_bn.to_dcm());
+            let yaml = format!(
+                "imupath: \"{}\"\ngnsspath: \"{}\"\noutputpath: \"{}\"\nimudatalen: 7\n\
+                 imudatarate: 200\nstarttime: 0\nendtime: -1\ninitpos: [{}, {}, {}]\n\
+                 initvel: [{}, {}, {}]\ninitatt: [{}, {}, {}]\ninitgyrbias: [0, 0, 0]\n\
+                 initaccbias: [0, 0, 0]\ninitgyrscale: [0, 0, 0]\ninitaccscale: [0, 0, 0]\n\
+                 initposstd: [0.05, 0.05, 0.05]\ninitvelstd: [0.05, 0.05, 0.05]\n\
+                 initattstd: [0.5, 0.5, 0.5]\nimunoise:\n  arw: [0.5, 0.5, 0.5]\n\
+                 \x20 vrw: [0.1, 0.1, 0.1]\n  gbstd: [100, 100, 100]\n  abstd: [5000, 5000, 5000]\n\
+                 \x20 gsstd: [5000, 5000, 5000]\n  asstd: [5000, 5000, 5000]\n  corrtime: 1.0\n\
+                 antlever: [0, 0, 0]\n",
+                dir.join("imu.txt").display(),
+                dir.join("gnss.txt").display(),
+                dir.join("out").display(),
+                start.lat_rad.to_degrees(),
+                start.lon_rad.to_degrees(),
+                start.height_m,
+                start.vel_ned_m_s[0],
+                start.vel_ned_m_s[1],
+                start.vel_ned_m_s[2],
+                e0.roll_rad.to_degrees(),
+                e0.pitch_rad.to_degrees(),
+                e0.yaw_rad.to_degrees()
+            );
+            let cfg_path = dir.join("kf-gins.yaml");
+            std::fs::write(&cfg_path, yaml)?;
+            let (kbest, kmed) = time_runs(a.runs.min(3), || {
+                crate::nav_cmd::kf_gins_job(&cfg_path, "none", false).map(|_| ())
+            })?;
+            results.push((
+                format!(
+                    "driftless nav --kf-gins end to end: {imu_mb:.0} MB IMU text + GNSS + YAML in, 3 KF-GINS files out"
+                ),
+                kbest,
+                kmed,
+                format!("{:.2} µs/epoch", kbest / n_epochs as f64 * 1e6),
+            ));
+            if !a.keep {
+                let _ = std::fs::remove_dir_all(&dir);
+            }
+        }
         if let Some(run) = &last_run {
             let (sbest, smed) = time_runs(a.runs.min(3), || Ok(smooth(run, &init, &cfg)?))?;
             results.push((

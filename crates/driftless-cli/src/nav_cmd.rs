@@ -257,17 +257,62 @@ pub fn run(a: NavArgs) -> Result<()> {
 /// KF-GINS gives noise per axis; this filter takes one value per sensor, so the worst
 /// axis is used.
 fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
+    let job = kf_gins_job(path, &a.outages, true)?;
+    write_extra_outputs(a, &job.solution, job.dt_s)?;
+    let (run, files) = (&job.run, &job.files);
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "epochs": run.epochs.len(),
+                "gnss_accepted": run.gnss_accepted,
+                "gnss_rejected": run.gnss_rejected,
+                "gnss_withheld": run.gnss_withheld,
+                "outputs": files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
+            }))?
+        );
+    } else {
+        println!(
+            "{}: {} epochs from {:.3} s, GNSS {} accepted, {} rejected, {} withheld",
+            path.display(),
+            run.epochs.len(),
+            job.start_time_s,
+            run.gnss_accepted,
+            run.gnss_rejected,
+            run.gnss_withheld
+        );
+        for f in files {
+            println!("wrote {}", f.display());
+        }
+    }
+    Ok(())
+}
+
+/// What a `--kf-gins` job produced.
+pub struct KfGinsJob {
+    pub run: driftless::nav::filter::run::ForwardRun,
+    pub solution: driftless::io::nav::NavSolution,
+    pub files: [PathBuf; 3],
+    pub start_time_s: f64,
+    pub dt_s: f64,
+}
+
+/// Read a KF-GINS configuration and its files, run the forward filter, write KF-GINS's
+/// three output files.
+pub fn kf_gins_job(path: &std::path::Path, outages: &str, verbose: bool) -> Result<KfGinsJob> {
     use driftless::io::nav::{KfGinsConfig, read_kfgins_gnss_file};
     use driftless::nav::attitude::Euler;
     use driftless::nav::filter::run::{InitialState, run_forward};
     use driftless::nav::filter::state::SensorErrors;
     use driftless::nav::mechanization::NavState;
     let k = KfGinsConfig::from_file(path)?;
-    for key in &k.unknown_keys {
-        eprintln!(
-            "note: {}: key `{key}` is not used by KF-GINS and is ignored",
-            path.display()
-        );
+    if verbose {
+        for key in &k.unknown_keys {
+            eprintln!(
+                "note: {}: key `{key}` is not used by KF-GINS and is ignored",
+                path.display()
+            );
+        }
     }
     let inc = read_kfgins_imu_file(&k.imu_path)?;
     let imu = imu_from_kfgins(
@@ -291,7 +336,7 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
         accel_scale: gm(n.accel_scale_std),
     };
     let mut cfg = FilterConfig::new(noise, k.antenna_lever_frd_m);
-    let spec: OutageSpec = a.outages.parse().context("--outages")?;
+    let spec: OutageSpec = outages.parse().context("--outages")?;
     if spec != OutageSpec::None {
         let sel = select_gnss(&gnss, &imu, &spec, GnssOutsideImu::Drop)?;
         cfg.outages_s = sel.windows.iter().map(|w| (w.start_s, w.end_s)).collect();
@@ -343,33 +388,13 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
         .with_context(|| format!("creating {}", k.output_dir.display()))?;
     let (sol, err, std) = solution_records(&run);
     let files = driftless::io::nav::write_kfgins_outputs(&k.output_dir, &sol, &err, &std, 0)?;
-    write_extra_outputs(a, &sol, imu.nominal_dt_s)?;
-    if a.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::json!({
-                "epochs": run.epochs.len(),
-                "gnss_accepted": run.gnss_accepted,
-                "gnss_rejected": run.gnss_rejected,
-                "gnss_withheld": run.gnss_withheld,
-                "outputs": files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
-            }))?
-        );
-    } else {
-        println!(
-            "{}: {} epochs from {:.3} s, GNSS {} accepted, {} rejected, {} withheld",
-            path.display(),
-            run.epochs.len(),
-            k.start_time_s,
-            run.gnss_accepted,
-            run.gnss_rejected,
-            run.gnss_withheld
-        );
-        for f in &files {
-            println!("wrote {}", f.display());
-        }
-    }
-    Ok(())
+    Ok(KfGinsJob {
+        run,
+        solution: sol,
+        files,
+        start_time_s: k.start_time_s,
+        dt_s: imu.nominal_dt_s,
+    })
 }
 
 /// `--csv` and `--geojson`.

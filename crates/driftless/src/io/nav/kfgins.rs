@@ -340,9 +340,119 @@ pub fn read_kfgins_gnss(
 }
 
 /// Appends one value in KF-GINS's `"%-15.9lf "` format.
+///
+/// Fast path for |v| < 4e9: integer part and 9 fractional digits by integer arithmetic
+/// (the fraction v − trunc(v) is exact; its scaling by 1e9 errs by < 1e-6 of a unit, so
+/// the rounding is the correctly rounded decimal except within 1e-6 of a tie, where the
+/// standard formatter takes over). Output is identical to `format!("{v:<15.9} ")`,
+/// several times faster — the writers emit ~33 M values per hour of 200 Hz data.
 fn push_value(line: &mut String, v: f64) {
     use std::fmt::Write as _;
+    let a = v.abs();
+    if a < 4.0e9 {
+        // truncation by conversion (exact below 2^53), no libm call
+        let int0 = a as u64;
+        let f = (a - int0 as f64) * 1e9;
+        let f_floor = f as u64;
+        let tie_dist = (f - f_floor as f64 - 0.5).abs();
+        if tie_dist > 1e-6 {
+            let mut int = int0;
+            let mut frac = if f - f_floor as f64 > 0.5 {
+                f_floor + 1
+            } else {
+                f_floor
+            };
+            if frac >= 1_000_000_000 {
+                frac -= 1_000_000_000;
+                int += 1;
+            }
+            // [sign] integer digits '.' 9 digits, left-aligned in 15, then a space
+            let mut buf = [b' '; 40];
+            let mut n = 0;
+            if v.is_sign_negative() {
+                buf[0] = b'-';
+                n = 1;
+            }
+            let mut digits = [0u8; 20];
+            let mut k = 0;
+            loop {
+                digits[k] = b'0' + (int % 10) as u8;
+                int /= 10;
+                k += 1;
+                if int == 0 {
+                    break;
+                }
+            }
+            for d in digits[..k].iter().rev() {
+                buf[n] = *d;
+                n += 1;
+            }
+            buf[n] = b'.';
+            n += 1;
+            for p in (0..9).rev() {
+                buf[n + p] = b'0' + (frac % 10) as u8;
+                frac /= 10;
+            }
+            n += 9;
+            let end = n.max(15) + 1;
+            // ASCII only, so this cannot fail
+            if let Ok(text) = std::str::from_utf8(&buf[..end]) {
+                line.push_str(text);
+                return;
+            }
+        }
+    }
     let _ = write!(line, "{v:<15.9} ");
+}
+
+#[cfg(test)]
+mod push_value_tests {
+    use super::push_value;
+
+    #[test]
+    fn matches_the_standard_formatter() {
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        let mut checked = 0;
+        for i in 0..1_000_000u64 {
+            let r = next();
+            let mag = 10f64.powi((r % 24) as i32 - 12);
+            let v = match i % 5 {
+                0 => (r >> 11) as f64 / (1u64 << 53) as f64 * mag,
+                1 => -((r >> 11) as f64 / (1u64 << 53) as f64) * mag,
+                2 => (r % 1_000_000_000) as f64 * 1e-9 + (r % 1000) as f64, // on the grid
+                3 => 243_300.0 + (r >> 11) as f64 / (1u64 << 53) as f64 * 600.0,
+                _ => f64::from_bits(r) % 5e9,
+            };
+            if !v.is_finite() {
+                continue;
+            }
+            let mut fast = String::new();
+            push_value(&mut fast, v);
+            assert_eq!(fast, format!("{v:<15.9} "), "value {v:e}");
+            checked += 1;
+        }
+        for v in [
+            0.0,
+            -0.0,
+            0.5e-9,
+            1.5e-9,
+            -2.5e-9,
+            3_999_999_999.999_999_9,
+            1e10,
+            -1e12,
+        ] {
+            let mut fast = String::new();
+            push_value(&mut fast, v);
+            assert_eq!(fast, format!("{v:<15.9} "), "value {v:e}");
+        }
+        assert!(checked > 900_000);
+    }
 }
 
 /// Writes rows of values after checking that every value is finite.
@@ -480,9 +590,19 @@ pub fn write_kfgins_outputs(
             })
     };
     let name = |p: &Path| p.display().to_string();
-    write_kfgins_nav(create(&paths[0])?, &name(&paths[0]), sol, gps_week)?;
-    write_kfgins_imu_err(create(&paths[1])?, &name(&paths[1]), imu_err)?;
-    write_kfgins_std(create(&paths[2])?, &name(&paths[2]), std)?;
+    // The three files are independent and formatting-bound: write them concurrently.
+    let ((nav, err), std_res) = rayon::join(
+        || {
+            rayon::join(
+                || write_kfgins_nav(create(&paths[0])?, &name(&paths[0]), sol, gps_week),
+                || write_kfgins_imu_err(create(&paths[1])?, &name(&paths[1]), imu_err),
+            )
+        },
+        || write_kfgins_std(create(&paths[2])?, &name(&paths[2]), std),
+    );
+    nav?;
+    err?;
+    std_res?;
     Ok(paths)
 }
 

@@ -104,7 +104,8 @@ pub(crate) fn parse_num(
     name: &str,
 ) -> Result<f64, LogError> {
     let at = Location::field(name_path, line, f.col);
-    match f.text.parse::<f64>() {
+    // The text reader's scanner: exact (Clinger's fast path, else the standard parser).
+    match super::number::parse_f64(f.text.as_bytes()).ok_or(()) {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(_) => Err(LogError::NonFinite {
             at,
