@@ -166,6 +166,7 @@ pub fn run(a: NavArgs) -> Result<()> {
     cfg.outages = windows;
     let res = run_session(&imu, &all.fixes, &cfg)?;
 
+    log_rejections(&res.run, 20);
     let (sol, err, std) = solution_records(&res.run);
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -258,6 +259,7 @@ pub fn run(a: NavArgs) -> Result<()> {
 /// axis is used.
 fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
     let job = kf_gins_job(path, &a.outages, true)?;
+    log_rejections(&job.run, 20);
     write_extra_outputs(a, &job.solution, job.dt_s)?;
     let (run, files) = (&job.run, &job.files);
     if a.json {
@@ -416,4 +418,21 @@ fn write_extra_outputs(
         write_track_geojson(p, sol, stride)?;
     }
     Ok(())
+}
+
+/// Log the measurements the χ² gate rejected (stderr; at most `max` lines).
+fn log_rejections(run: &driftless::nav::filter::run::ForwardRun, max: usize) {
+    let mut n = 0usize;
+    for o in run.rejections() {
+        if n < max {
+            eprintln!(
+                "rejected {:?} at {:.3} s: NIS {:.1}, innovation N/E/D {:.3} {:.3} {:.3}",
+                o.kind, o.time_s, o.nis, o.innovation[0], o.innovation[1], o.innovation[2]
+            );
+        }
+        n += 1;
+    }
+    if n > max {
+        eprintln!("… {} more rejections", n - max);
+    }
 }
