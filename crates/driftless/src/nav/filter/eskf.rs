@@ -598,24 +598,32 @@ impl Eskf {
 
     /// Apply the estimated error state and reset it (module docs).
     fn feedback(&mut self, dx: &[f64; N_STATES]) {
-        let n = &mut self.nav;
-        let rm_h = earth::meridian_radius_m(n.lat_rad) + n.height_m;
-        let rn_h = earth::prime_vertical_radius_m(n.lat_rad) + n.height_m;
-        n.lon_rad -= dx[POS + 1] / (rn_h * n.lat_rad.cos());
-        n.lat_rad -= dx[POS] / rm_h;
-        n.height_m += dx[POS + 2];
-        for k in 0..3 {
-            n.vel_ned_m_s[k] -= dx[VEL + k];
-        }
-        let phi = [dx[ATT], dx[ATT + 1], dx[ATT + 2]];
+        apply_error_state(&mut self.nav, &mut self.sensors, dx);
+    }
+}
+
+/// Correct a navigation state and sensor-error estimates by an error state δx (module
+/// docs for the sign conventions): position and velocity are "estimate − truth", the
+/// attitude error φ rotates by q(φ) ⊗ q_bn, sensor-error states add. Shared by the
+/// filter's feedback and the smoother.
+pub(crate) fn apply_error_state(n: &mut NavState, s: &mut SensorErrors, dx: &[f64; N_STATES]) {
+    let rm_h = earth::meridian_radius_m(n.lat_rad) + n.height_m;
+    let rn_h = earth::prime_vertical_radius_m(n.lat_rad) + n.height_m;
+    n.lon_rad -= dx[POS + 1] / (rn_h * n.lat_rad.cos());
+    n.lat_rad -= dx[POS] / rm_h;
+    n.height_m += dx[POS + 2];
+    for k in 0..3 {
+        n.vel_ned_m_s[k] -= dx[VEL + k];
+    }
+    let phi = [dx[ATT], dx[ATT + 1], dx[ATT + 2]];
+    if phi != [0.0; 3] {
         n.q_bn = Quat::from_rotation_vector(phi).mul(&n.q_bn).normalized();
-        let s = &mut self.sensors;
-        for k in 0..3 {
-            s.gyro_bias_rad_s[k] += dx[BG + k];
-            s.accel_bias_m_s2[k] += dx[BA + k];
-            s.gyro_scale[k] += dx[SG + k];
-            s.accel_scale[k] += dx[SA + k];
-        }
+    }
+    for k in 0..3 {
+        s.gyro_bias_rad_s[k] += dx[BG + k];
+        s.accel_bias_m_s2[k] += dx[BA + k];
+        s.gyro_scale[k] += dx[SG + k];
+        s.accel_scale[k] += dx[SA + k];
     }
 }
 

@@ -554,7 +554,7 @@ impl Transition {
 
     /// The 9 navigation rows of A as a dense 9 × 21 array (sensor rows are diagonal).
     #[inline]
-    fn nav_rows(&self) -> [[f64; N_STATES]; 9] {
+    pub(crate) fn nav_rows(&self) -> [[f64; N_STATES]; 9] {
         let mut a = [[0.0; N_STATES]; 9];
         for r in 0..3 {
             for c in 0..3 {

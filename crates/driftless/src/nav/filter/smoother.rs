@@ -91,7 +91,6 @@ use super::NavError;
 use super::model::{FilterConfig, Transition};
 use super::run::{ForwardRun, InitialState};
 use super::state::{ATT, BA, BG, Cov, N_STATES, POS, SA, SG, SensorErrors, VEL, unpack};
-use crate::nav::attitude::Quat;
 use crate::nav::earth;
 use crate::nav::mechanization::{NavState, mechanize};
 
@@ -354,30 +353,14 @@ fn symmetrize(m: &mut Cov) {
     }
 }
 
-/// Dense navigation rows of A = Φ − I (9 × 21) and the diagonal of Φ.
+/// Dense navigation rows of A = Φ − I (9 × 21, the transition's own) and the diagonal
+/// of Φ.
 fn nav_rows(t: &Transition) -> ([[f64; N_STATES]; 9], [f64; N_STATES]) {
-    let mut a = [[0.0; N_STATES]; 9];
-    for r in 0..3 {
-        for c in 0..3 {
-            a[POS + r][POS + c] = t.rr[r][c];
-            a[VEL + r][POS + c] = t.vr[r][c];
-            a[VEL + r][VEL + c] = t.vv[r][c];
-            a[VEL + r][ATT + c] = t.vphi[r][c];
-            a[VEL + r][BA + c] = t.vba[r][c];
-            a[VEL + r][SA + c] = t.vsa[r][c];
-            a[ATT + r][POS + c] = t.phir[r][c];
-            a[ATT + r][VEL + c] = t.phiv[r][c];
-            a[ATT + r][ATT + c] = t.phiphi[r][c];
-            a[ATT + r][BG + c] = t.phibg[r][c];
-            a[ATT + r][SG + c] = t.phisg[r][c];
-        }
-        a[POS + r][VEL + r] = t.dt_s;
-    }
     let mut e = [1.0; N_STATES];
     for s in 0..12 {
         e[BG + s] = 1.0 + t.sensor[s];
     }
-    (a, e)
+    (t.nav_rows(), e)
 }
 
 /// λ ← Φᵀ λ, Λ ← Φᵀ Λ Φ.
@@ -512,27 +495,10 @@ fn output(
             ps[i] = acc;
         }
     }
-    // Apply e_s to the stored state exactly as Eskf's feedback applies δx̂.
+    // Apply e_s to the stored state exactly as the filter's feedback applies δx̂.
     let mut nav = rec.nav;
-    let rm_h = earth::meridian_radius_m(nav.lat_rad) + nav.height_m;
-    let rn_h = earth::prime_vertical_radius_m(nav.lat_rad) + nav.height_m;
-    nav.lon_rad -= e_s[POS + 1] / (rn_h * nav.lat_rad.cos());
-    nav.lat_rad -= e_s[POS] / rm_h;
-    nav.height_m += e_s[POS + 2];
-    for c in 0..3 {
-        nav.vel_ned_m_s[c] -= e_s[VEL + c];
-    }
-    let phi = [e_s[ATT], e_s[ATT + 1], e_s[ATT + 2]];
-    if phi != [0.0; 3] {
-        nav.q_bn = Quat::from_rotation_vector(phi).mul(&nav.q_bn).normalized();
-    }
     let mut sensors = rec.sensors;
-    for c in 0..3 {
-        sensors.gyro_bias_rad_s[c] += e_s[BG + c];
-        sensors.accel_bias_m_s2[c] += e_s[BA + c];
-        sensors.gyro_scale[c] += e_s[SG + c];
-        sensors.accel_scale[c] += e_s[SA + c];
-    }
+    super::eskf::apply_error_state(&mut nav, &mut sensors, &e_s);
     Ok((SmoothedEpoch { nav, sensors, std }, e_s))
 }
 
