@@ -277,37 +277,26 @@ pub fn run(a: BenchArgs) -> Result<()> {
         // End to end as KF-GINS is used: its text IMU and GNSS files and YAML in, its
         // three output files out (`driftless nav --kf-gins`).
         {
-            use std::fmt::Write as _;
+            use driftless::io::nav::{ImuIncrements, write_kfgins_gnss, write_kfgins_imu};
             let dir = a.dir.join("kfgins");
             std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-            let mut text = String::with_capacity(incs.len() * 120);
-            for inc in &incs {
-                let _ = writeln!(
-                    text,
-                    "{:.3} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e}",
-                    inc.time_s,
-                    inc.dtheta_rad[0],
-                    inc.dtheta_rad[1],
-                    inc.dtheta_rad[2],
-                    inc.dvel_m_s[0],
-                    inc.dvel_m_s[1],
-                    inc.dvel_m_s[2]
-                );
-            }
-            std::fs::write(dir.join("imu.txt"), &text)?;
-            let imu_mb = text.len() as f64 / 1e6;
-            let mut gt = String::new();
-            for i in 0..g.time_s.len() {
-                let _ = writeln!(
-                    gt,
-                    "{:.3} {:.10} {:.10} {:.4} 0.02 0.02 0.04",
-                    g.time_s[i],
-                    g.lat_rad[i].to_degrees(),
-                    g.lon_rad[i].to_degrees(),
-                    g.height_m[i]
-                );
-            }
-            std::fs::write(dir.join("gnss.txt"), gt)?;
+            let cols = ImuIncrements {
+                time_s: incs.iter().map(|i| i.time_s).collect(),
+                dtheta_rad: incs.iter().map(|i| i.dtheta_rad).collect(),
+                dvel_m_s: incs.iter().map(|i| i.dvel_m_s).collect(),
+            };
+            let imu_file = dir.join("imu.txt");
+            write_kfgins_imu(
+                std::io::BufWriter::new(std::fs::File::create(&imu_file)?),
+                "imu.txt",
+                &cols,
+            )?;
+            let imu_mb = std::fs::metadata(&imu_file)?.len() as f64 / 1e6;
+            write_kfgins_gnss(
+                std::io::BufWriter::new(std::fs::File::create(dir.join("gnss.txt"))?),
+                "gnss.txt",
+                &g,
+            )?;
             let e0 = driftless::nav::attitude::Euler::from_dcm(&start.q_bn.to_dcm());
             let yaml = format!(
                 "imupath: \"{}\"\ngnsspath: \"{}\"\noutputpath: \"{}\"\nimudatalen: 7\n\

@@ -2,9 +2,9 @@
 //! with known truth (ideal increments of a constant-rate turn, exact GNSS fixes with 2 cm
 //! σ labels), checking KF-GINS's output files and the final position.
 
+use driftless::io::nav::{GnssFixes, ImuIncrements, write_kfgins_gnss, write_kfgins_imu};
 use driftless::nav::attitude::Euler;
 use driftless::sim::ideal_imu::{ConstantTurn, Trajectory, ideal_increments};
-use std::fmt::Write as _;
 use std::process::Command;
 
 fn bin() -> Command {
@@ -28,36 +28,25 @@ fn kf_gins_config_runs_unchanged_and_writes_its_three_files() {
     };
     let dt = 0.005;
     let n = 24_000; // 120 s at 200 Hz
-    let mut imu = String::new();
-    for (k, inc) in ideal_increments(&turn, dt, dt, n).enumerate() {
-        let t = t0 + (k + 1) as f64 * dt;
-        writeln!(
-            imu,
-            "{t:.3} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e}",
-            inc.dtheta_rad[0],
-            inc.dtheta_rad[1],
-            inc.dtheta_rad[2],
-            inc.dvel_m_s[0],
-            inc.dvel_m_s[1],
-            inc.dvel_m_s[2]
-        )
-        .unwrap();
-    }
-    let mut gnss = String::new();
+    let incs: Vec<_> = ideal_increments(&turn, dt, dt, n).collect();
+    let imu = ImuIncrements {
+        time_s: (0..n).map(|k| t0 + (k + 1) as f64 * dt).collect(),
+        dtheta_rad: incs.iter().map(|i| i.dtheta_rad).collect(),
+        dvel_m_s: incs.iter().map(|i| i.dvel_m_s).collect(),
+    };
+    let mut gnss = GnssFixes::default();
     for s in 1..120 {
         let p = turn.point(s as f64);
-        writeln!(
-            gnss,
-            "{:.3} {:.10} {:.10} {:.4} 0.02 0.02 0.04",
-            t0 + s as f64,
-            p.lat_rad.to_degrees(),
-            p.lon_rad.to_degrees(),
-            p.height_m
-        )
-        .unwrap();
+        gnss.time_s.push(t0 + s as f64);
+        gnss.lat_rad.push(p.lat_rad);
+        gnss.lon_rad.push(p.lon_rad);
+        gnss.height_m.push(p.height_m);
+        gnss.sigma_ned_m.push([0.02, 0.02, 0.04]);
+        gnss.quality.push(0);
     }
-    std::fs::write(dir.join("data/imu.txt"), imu).unwrap();
-    std::fs::write(dir.join("data/gnss.txt"), gnss).unwrap();
+    let file = |p: &str| std::fs::File::create(dir.join(p)).unwrap();
+    write_kfgins_imu(file("data/imu.txt"), "imu.txt", &imu).unwrap();
+    write_kfgins_gnss(file("data/gnss.txt"), "gnss.txt", &gnss).unwrap();
     let p0 = turn.point(0.0);
     let e0 = Euler::from_dcm(&p0.c_bn);
     let cfg = format!(
