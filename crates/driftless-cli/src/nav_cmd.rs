@@ -260,7 +260,10 @@ pub fn run(a: NavArgs) -> Result<()> {
 fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
     let job = kf_gins_job(path, &a.outages, true)?;
     log_rejections(&job.run, 20);
-    write_extra_outputs(a, &job.solution, job.dt_s)?;
+    if a.csv.is_some() || a.geojson.is_some() {
+        let (sol, _, _) = solution_records(&job.run);
+        write_extra_outputs(a, &sol, job.dt_s)?;
+    }
     let (run, files) = (&job.run, &job.files);
     if a.json {
         println!(
@@ -293,7 +296,6 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
 /// What a `--kf-gins` job produced.
 pub struct KfGinsJob {
     pub run: driftless::nav::filter::run::ForwardRun,
-    pub solution: driftless::io::nav::NavSolution,
     pub files: [PathBuf; 3],
     pub start_time_s: f64,
     pub dt_s: f64,
@@ -304,9 +306,10 @@ pub struct KfGinsJob {
 pub fn kf_gins_job(path: &std::path::Path, outages: &str, verbose: bool) -> Result<KfGinsJob> {
     use driftless::io::nav::{KfGinsConfig, read_kfgins_gnss_file};
     use driftless::nav::attitude::Euler;
-    use driftless::nav::filter::run::{InitialState, run_forward};
+    use driftless::nav::filter::run::{EpochRecord, InitialState, run_forward_observed};
     use driftless::nav::filter::state::SensorErrors;
     use driftless::nav::mechanization::NavState;
+    use driftless::nav::session::epoch_solution_records;
     let k = KfGinsConfig::from_file(path)?;
     if verbose {
         for key in &k.unknown_keys {
@@ -385,14 +388,34 @@ pub fn kf_gins_job(path: &std::path::Path, outages: &str, verbose: bool) -> Resu
     };
     let end = k.end_time_s.unwrap_or(f64::INFINITY);
     let n_end = imu.epochs.partition_point(|e| e.time_s <= end);
-    let run = run_forward(&imu.epochs[..n_end], &gnss, init, &cfg)?;
     std::fs::create_dir_all(&k.output_dir)
         .with_context(|| format!("creating {}", k.output_dir.display()))?;
-    let (sol, err, std) = solution_records(&run);
-    let files = driftless::io::nav::write_kfgins_outputs(&k.output_dir, &sol, &err, &std, 0)?;
+    let mut writer = driftless::io::nav::KfGinsOutputWriter::create(&k.output_dir, 0)?;
+    // The filter runs on this thread; the output files are formatted and written on
+    // another from the blocks of epoch records the filter hands out.
+    let (run, files) = std::thread::scope(|scope| -> Result<_> {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<EpochRecord>>(8);
+        let formatter = scope.spawn(move || -> Result<[PathBuf; 3]> {
+            for block in rx {
+                let (sol, err, std) = epoch_solution_records(&block);
+                writer.append(&sol, &err, &std)?;
+            }
+            Ok(writer.finish()?)
+        });
+        let run = run_forward_observed(&imu.epochs[..n_end], &gnss, init, &cfg, &mut |b| {
+            // A send fails only when the formatter has stopped on an error, which
+            // `join` reports below.
+            let _ = tx.send(b.to_vec());
+        });
+        drop(tx);
+        let files = formatter
+            .join()
+            .map_err(|_| anyhow::anyhow!("the output writer thread panicked"))?;
+        let run = run?;
+        Ok((run, files?))
+    })?;
     Ok(KfGinsJob {
         run,
-        solution: sol,
         files,
         start_time_s: k.start_time_s,
         dt_s: imu.nominal_dt_s,

@@ -551,3 +551,28 @@ fn invalid_aid_settings_are_rejected() {
     cfg.nhc = Some(NhcConfig::default());
     assert!(cfg.validate().is_ok());
 }
+
+/// `run_forward_observed` hands out every epoch record once, in order, in its final
+/// form (GNSS and vehicle-aid updates rewrite the newest record after it is pushed),
+/// and changes nothing in the run.
+#[test]
+fn observer_sees_the_final_records() {
+    use driftless::nav::filter::run::OBSERVER_BLOCK;
+    use driftless::nav::filter::run_forward_observed;
+    let d = data(Mat3::IDENTITY, None);
+    let mut cfg = base_config();
+    cfg.nhc = Some(NhcConfig::default());
+    cfg.standstill = Some(StandstillConfig::default());
+    let plain = run_forward(&d.imu, &d.gnss, initial(&d.traj), &cfg).expect("forward run");
+    let mut seen = Vec::new();
+    let mut blocks = 0;
+    let observed = run_forward_observed(&d.imu, &d.gnss, initial(&d.traj), &cfg, &mut |b| {
+        blocks += 1;
+        seen.extend_from_slice(b);
+    })
+    .expect("forward run");
+    assert_eq!(observed, plain);
+    assert!(plain.nhc_applied > 0 && plain.zupt_applied > 0 && plain.gnss_accepted > 0);
+    assert_eq!(seen, plain.epochs);
+    assert!(blocks > 1 && blocks <= plain.epochs.len() / OBSERVER_BLOCK + 1);
+}

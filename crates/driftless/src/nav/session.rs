@@ -455,12 +455,24 @@ pub fn solution_records(
     crate::io::nav::ImuErrors,
     crate::io::nav::NavStd,
 ) {
+    epoch_solution_records(&run.epochs)
+}
+
+/// [`solution_records`] of a block of epoch records (e.g. one handed out by
+/// [`super::filter::run_forward_observed`]).
+pub fn epoch_solution_records(
+    epochs: &[super::filter::EpochRecord],
+) -> (
+    crate::io::nav::NavSolution,
+    crate::io::nav::ImuErrors,
+    crate::io::nav::NavStd,
+) {
     use super::filter::state::{ATT, BA, BG, POS, SA, SG, VEL};
     let mut sol = crate::io::nav::NavSolution::default();
     let mut err = crate::io::nav::ImuErrors::default();
     let mut std = crate::io::nav::NavStd::default();
     let tri = |s: &[f64], i: usize| [s[i], s[i + 1], s[i + 2]];
-    for e in &run.epochs {
+    for e in epochs {
         let n = &e.nav;
         let att = Euler::from_dcm(&n.q_bn.to_dcm());
         sol.time_s.push(n.time_s);

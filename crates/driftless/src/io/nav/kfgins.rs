@@ -33,7 +33,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use super::types::{GnssFixes, ImuErrors, ImuIncrements, NavSolution, NavStd, common_len};
-use super::{Field, as_utf8, check_time_order, parse_num, read_file, split_fields};
+use super::{
+    Field, as_utf8, check_time_order, parse_num, read_file, split_fields, split_fields_into,
+};
 use crate::io::{Location, LogError};
 
 /// Field separators of KF-GINS's text loader.
@@ -180,45 +182,163 @@ pub fn read_kfgins_imu_file(path: impl AsRef<Path>) -> Result<ImuIncrements, Log
     read_kfgins_imu(&read_file(path)?, &path.display().to_string())
 }
 
-/// Reads KF-GINS IMU text from memory; `name` is used in error messages.
+/// Reads KF-GINS IMU text from memory; `name` is used in error messages. Large inputs
+/// are parsed in parallel blocks of whole lines; the first error in file order is
+/// reported, as a sequential reader would.
 pub fn read_kfgins_imu(bytes: &[u8], name: &str) -> Result<ImuIncrements, LogError> {
+    read_imu_in_blocks(bytes, name, IMU_BLOCK_BYTES)
+}
+
+fn read_imu_in_blocks(
+    bytes: &[u8],
+    name: &str,
+    block_bytes: usize,
+) -> Result<ImuIncrements, LogError> {
+    use rayon::prelude::*;
     let text = as_utf8(bytes, name)?;
-    let mut out = ImuIncrements::default();
-    let mut reference: Option<(usize, usize)> = None;
-    let mut prev: Option<f64> = None;
-    for (line, l) in data_lines(text) {
-        let fields = split_fields(l, SEPS);
-        let (expected, ref_line) = *reference.get_or_insert((fields.len(), line));
-        if expected < 7 {
-            let col = l.len() + 1;
-            return Err(LogError::Ragged {
-                at: Location::field(name, line, col),
-                found: fields.len(),
-                expected: 7,
-                reference_line: line,
-            });
-        }
-        check_count(&fields, l, expected, ref_line, name, line)?;
-        let mut v = [0.0; 7];
-        for (k, slot) in v.iter_mut().enumerate() {
-            *slot = parse_num(fields[k], name, line, k + 1, IMU_NAMES[k])?;
-        }
-        // Extra columns (odometer, …) must still be numbers, as KF-GINS reads them.
-        for (k, f) in fields.iter().enumerate().skip(7) {
-            parse_num(*f, name, line, k + 1, "extra")?;
-        }
-        check_time_order(v[0], prev, name, line, 1, IMU_NAMES[0])?;
-        prev = Some(v[0]);
-        out.time_s.push(v[0]);
-        out.dtheta_rad.push([v[1], v[2], v[3]]);
-        out.dvel_m_s.push([v[4], v[5], v[6]]);
-    }
-    if out.is_empty() {
+    // The first data row fixes the column count of all rows.
+    let Some((ref_line, first)) = data_lines(text).next() else {
         return Err(LogError::Empty {
             at: Location::input(name),
         });
+    };
+    let expected = split_fields(first, SEPS).len();
+    if expected < 7 {
+        return Err(LogError::Ragged {
+            at: Location::field(name, ref_line, first.len() + 1),
+            found: expected,
+            expected: 7,
+            reference_line: ref_line,
+        });
+    }
+    let blocks = line_blocks(text, block_bytes.max(1));
+    let parts: Vec<ImuBlock> = blocks
+        .par_iter()
+        .map(|&(line0, block)| parse_imu_block(block, line0, expected, ref_line, name))
+        .collect();
+    let n = parts.iter().map(|p| p.data.len()).sum();
+    let mut out = ImuIncrements {
+        time_s: Vec::with_capacity(n),
+        dtheta_rad: Vec::with_capacity(n),
+        dvel_m_s: Vec::with_capacity(n),
+    };
+    for part in parts {
+        // Time order across the block boundary, at the block's first data line.
+        if let (Some(&prev), Some(&t)) = (out.time_s.last(), part.data.time_s.first()) {
+            check_time_order(t, Some(prev), name, part.first_data_line, 1, IMU_NAMES[0])?;
+        }
+        if let Some(e) = part.error {
+            return Err(e);
+        }
+        out.time_s.extend_from_slice(&part.data.time_s);
+        out.dtheta_rad.extend_from_slice(&part.data.dtheta_rad);
+        out.dvel_m_s.extend_from_slice(&part.data.dvel_m_s);
     }
     Ok(out)
+}
+
+/// Target size of the blocks [`read_kfgins_imu`] parses in parallel, bytes.
+const IMU_BLOCK_BYTES: usize = 1 << 22;
+
+/// Splits `text` after newlines into blocks of about `target` bytes, each with the
+/// 1-based number of its first line.
+fn line_blocks(text: &str, target: usize) -> Vec<(usize, &str)> {
+    use rayon::prelude::*;
+    let bytes = text.as_bytes();
+    let mut cuts = vec![0];
+    let mut at = 0;
+    while at + target < bytes.len() {
+        let next = bytes[at + target..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |p| at + target + p + 1);
+        cuts.push(next);
+        at = next;
+    }
+    if *cuts.last().unwrap_or(&0) < bytes.len() {
+        cuts.push(bytes.len());
+    }
+    // Cuts are just after a '\n' (ASCII), so every slice is on a char boundary.
+    let pieces: Vec<&str> = cuts.windows(2).map(|w| &text[w[0]..w[1]]).collect();
+    let newlines: Vec<usize> = pieces
+        .par_iter()
+        .map(|p| p.bytes().filter(|&b| b == b'\n').count())
+        .collect();
+    let mut line0 = 1;
+    pieces
+        .into_iter()
+        .zip(newlines)
+        .map(|(p, nl)| {
+            let block = (line0, p);
+            line0 += nl;
+            block
+        })
+        .collect()
+}
+
+/// One parsed block: the rows before the first error, and that error.
+struct ImuBlock {
+    data: ImuIncrements,
+    first_data_line: usize,
+    error: Option<LogError>,
+}
+
+fn parse_imu_block(
+    block: &str,
+    line0: usize,
+    expected: usize,
+    ref_line: usize,
+    name: &str,
+) -> ImuBlock {
+    let mut out = ImuBlock {
+        data: ImuIncrements::default(),
+        first_data_line: line0,
+        error: None,
+    };
+    let mut prev: Option<f64> = None;
+    let mut fields = Vec::with_capacity(expected);
+    for (k, (line, l)) in data_lines(block).enumerate() {
+        let line = line + line0 - 1;
+        if k == 0 {
+            out.first_data_line = line;
+        }
+        match parse_imu_row(l, line, expected, ref_line, name, prev, &mut fields) {
+            Ok(v) => {
+                prev = Some(v[0]);
+                out.data.time_s.push(v[0]);
+                out.data.dtheta_rad.push([v[1], v[2], v[3]]);
+                out.data.dvel_m_s.push([v[4], v[5], v[6]]);
+            }
+            Err(e) => {
+                out.error = Some(e);
+                break;
+            }
+        }
+    }
+    out
+}
+
+fn parse_imu_row<'a>(
+    l: &'a str,
+    line: usize,
+    expected: usize,
+    ref_line: usize,
+    name: &str,
+    prev: Option<f64>,
+    fields: &mut Vec<Field<'a>>,
+) -> Result<[f64; 7], LogError> {
+    split_fields_into(l, SEPS, fields);
+    check_count(fields, l, expected, ref_line, name, line)?;
+    let mut v = [0.0; 7];
+    for (k, slot) in v.iter_mut().enumerate() {
+        *slot = parse_num(fields[k], name, line, k + 1, IMU_NAMES[k])?;
+    }
+    // Extra columns (odometer, …) must still be numbers, as KF-GINS reads them.
+    for (k, f) in fields.iter().enumerate().skip(7) {
+        parse_num(*f, name, line, k + 1, "extra")?;
+    }
+    check_time_order(v[0], prev, name, line, 1, IMU_NAMES[0])?;
+    Ok(v)
 }
 
 const GNSS_NAMES_7: [&str; 7] = [
@@ -346,8 +466,7 @@ pub fn read_kfgins_gnss(
 /// the rounding is the correctly rounded decimal except within 1e-6 of a tie, where the
 /// standard formatter takes over). Output is identical to `format!("{v:<15.9} ")`,
 /// several times faster — the writers emit ~33 M values per hour of 200 Hz data.
-fn push_value(line: &mut String, v: f64) {
-    use std::fmt::Write as _;
+fn push_value(line: &mut Vec<u8>, v: f64) {
     let a = v.abs();
     if a < 4.0e9 {
         // truncation by conversion (exact below 2^53), no libm call
@@ -366,43 +485,61 @@ fn push_value(line: &mut String, v: f64) {
                 frac -= 1_000_000_000;
                 int += 1;
             }
-            // [sign] integer digits '.' 9 digits, left-aligned in 15, then a space
-            let mut buf = [b' '; 40];
-            let mut n = 0;
-            if v.is_sign_negative() {
-                buf[0] = b'-';
-                n = 1;
-            }
-            let mut digits = [0u8; 20];
-            let mut k = 0;
-            loop {
-                digits[k] = b'0' + (int % 10) as u8;
-                int /= 10;
-                k += 1;
-                if int == 0 {
-                    break;
-                }
-            }
-            for d in digits[..k].iter().rev() {
-                buf[n] = *d;
-                n += 1;
-            }
+            // [sign] integer digits '.' 9 digits, left-aligned in 15, then a space:
+            // at most 1 + 10 + 1 + 9 + 1 = 22 bytes. The digits go straight into the
+            // line (space-filled first, cut back after): assembling them in a stack
+            // buffer and copying it costs a store-forwarding stall per value.
+            let len = line.len();
+            line.resize(len + 24, b' ');
+            let buf = &mut line[len..];
+            let mut n = usize::from(v.is_sign_negative());
+            buf[0] = b'-';
+            let int_digits = decimal_digits(int);
+            push_digits(&mut buf[n..n + int_digits], int);
+            n += int_digits;
             buf[n] = b'.';
-            n += 1;
-            for p in (0..9).rev() {
-                buf[n + p] = b'0' + (frac % 10) as u8;
-                frac /= 10;
-            }
-            n += 9;
-            let end = n.max(15) + 1;
-            // ASCII only, so this cannot fail
-            if let Ok(text) = std::str::from_utf8(&buf[..end]) {
-                line.push_str(text);
-                return;
-            }
+            push_digits(&mut buf[n + 1..n + 10], frac);
+            n += 10;
+            line.truncate(len + n.max(15) + 1);
+            return;
         }
     }
+    use std::io::Write as _;
     let _ = write!(line, "{v:<15.9} ");
+}
+
+/// Number of decimal digits of `x` (1 for 0).
+fn decimal_digits(x: u64) -> usize {
+    let mut d = 1;
+    let mut p = 10u64;
+    while d < 20 && x >= p {
+        d += 1;
+        p = p.saturating_mul(10);
+    }
+    d
+}
+
+/// "00".."99" as byte pairs.
+const DIGIT_PAIRS: &[u8; 200] = b"\
+0001020304050607080910111213141516171819\
+2021222324252627282930313233343536373839\
+4041424344454647484950515253545556575859\
+6061626364656667686970717273747576777879\
+8081828384858687888990919293949596979899";
+
+/// Writes `x` right-aligned into `out` (zero-padded to its full length), two digits
+/// per division.
+fn push_digits(out: &mut [u8], mut x: u64) {
+    let mut i = out.len();
+    while i >= 2 {
+        let r = (x % 100) as usize;
+        x /= 100;
+        out[i - 2..i].copy_from_slice(&DIGIT_PAIRS[2 * r..2 * r + 2]);
+        i -= 2;
+    }
+    if i == 1 {
+        out[0] = b'0' + (x % 10) as u8;
+    }
 }
 
 #[cfg(test)]
@@ -432,9 +569,9 @@ mod push_value_tests {
             if !v.is_finite() {
                 continue;
             }
-            let mut fast = String::new();
+            let mut fast = Vec::new();
             push_value(&mut fast, v);
-            assert_eq!(fast, format!("{v:<15.9} "), "value {v:e}");
+            assert_eq!(fast, format!("{v:<15.9} ").as_bytes(), "value {v:e}");
             checked += 1;
         }
         for v in [
@@ -447,27 +584,25 @@ mod push_value_tests {
             1e10,
             -1e12,
         ] {
-            let mut fast = String::new();
+            let mut fast = Vec::new();
             push_value(&mut fast, v);
-            assert_eq!(fast, format!("{v:<15.9} "), "value {v:e}");
+            assert_eq!(fast, format!("{v:<15.9} ").as_bytes(), "value {v:e}");
         }
         assert!(checked > 900_000);
     }
 }
 
-/// Writes rows of values after checking that every value is finite.
+/// Writes rows of values after checking that every value is finite; `first_row` numbers
+/// the rows in error messages. Does not flush.
 fn write_rows(
-    mut w: impl Write,
+    w: &mut impl Write,
     name: &str,
     n: usize,
+    first_row: usize,
     mut row: impl FnMut(usize, &mut Vec<f64>),
 ) -> Result<(), LogError> {
-    let io_err = |error| LogError::Io {
-        path: name.to_owned(),
-        error,
-    };
     let mut vals = Vec::with_capacity(22);
-    let mut line = String::with_capacity(22 * 16 + 1);
+    let mut line = Vec::with_capacity(22 * 24 + 1);
     for i in 0..n {
         vals.clear();
         row(i, &mut vals);
@@ -476,15 +611,26 @@ fn write_rows(
             if !v.is_finite() {
                 return Err(LogError::InvalidLog {
                     at: Location::input(name),
-                    message: format!("non-finite value {v} in row {i}, column {}", k + 1),
+                    message: format!(
+                        "non-finite value {v} in row {}, column {}",
+                        first_row + i,
+                        k + 1
+                    ),
                 });
             }
             push_value(&mut line, v);
         }
-        line.push('\n');
-        w.write_all(line.as_bytes()).map_err(io_err)?;
+        line.push(b'\n');
+        w.write_all(&line).map_err(|error| io_error(name, error))?;
     }
-    w.flush().map_err(io_err)
+    Ok(())
+}
+
+fn io_error(name: &str, error: std::io::Error) -> LogError {
+    LogError::Io {
+        path: name.to_owned(),
+        error,
+    }
 }
 
 fn lens_err(name: &str, message: String) -> LogError {
@@ -624,11 +770,22 @@ mod input_writer_tests {
 /// Writes a navigation solution in KF-GINS's `.nav` format (11 columns, see the module
 /// docs); `gps_week` goes into column 1 (KF-GINS itself always writes 0).
 pub fn write_kfgins_nav(
-    w: impl Write,
+    mut w: impl Write,
     name: &str,
     sol: &NavSolution,
     gps_week: u16,
 ) -> Result<(), LogError> {
+    append_nav(&mut w, name, sol, gps_week, 0)?;
+    w.flush().map_err(|e| io_error(name, e))
+}
+
+fn append_nav(
+    w: &mut impl Write,
+    name: &str,
+    sol: &NavSolution,
+    gps_week: u16,
+    first_row: usize,
+) -> Result<usize, LogError> {
     let n = common_len(&[
         ("time_s", sol.time_s.len()),
         ("lat_rad", sol.lat_rad.len()),
@@ -638,7 +795,7 @@ pub fn write_kfgins_nav(
         ("roll_pitch_yaw_rad", sol.roll_pitch_yaw_rad.len()),
     ])
     .map_err(|m| lens_err(name, m))?;
-    write_rows(w, name, n, |i, r| {
+    write_rows(w, name, n, first_row, |i, r| {
         r.push(f64::from(gps_week));
         r.push(sol.time_s[i]);
         r.push(sol.lat_rad[i] * R2D);
@@ -646,11 +803,22 @@ pub fn write_kfgins_nav(
         r.push(sol.height_m[i]);
         r.extend_from_slice(&sol.vel_ned_m_s[i]);
         r.extend(sol.roll_pitch_yaw_rad[i].iter().map(|a| a * R2D));
-    })
+    })?;
+    Ok(n)
 }
 
 /// Writes estimated IMU errors in KF-GINS's `KF_GINS_IMU_ERR.txt` format (13 columns).
-pub fn write_kfgins_imu_err(w: impl Write, name: &str, e: &ImuErrors) -> Result<(), LogError> {
+pub fn write_kfgins_imu_err(mut w: impl Write, name: &str, e: &ImuErrors) -> Result<(), LogError> {
+    append_imu_err(&mut w, name, e, 0)?;
+    w.flush().map_err(|err| io_error(name, err))
+}
+
+fn append_imu_err(
+    w: &mut impl Write,
+    name: &str,
+    e: &ImuErrors,
+    first_row: usize,
+) -> Result<usize, LogError> {
     let n = common_len(&[
         ("time_s", e.time_s.len()),
         ("gyro_bias_rad_s", e.gyro_bias_rad_s.len()),
@@ -659,17 +827,28 @@ pub fn write_kfgins_imu_err(w: impl Write, name: &str, e: &ImuErrors) -> Result<
         ("accel_scale", e.accel_scale.len()),
     ])
     .map_err(|m| lens_err(name, m))?;
-    write_rows(w, name, n, |i, r| {
+    write_rows(w, name, n, first_row, |i, r| {
         r.push(e.time_s[i]);
         r.extend(e.gyro_bias_rad_s[i].iter().map(|b| b * R2D * 3600.0));
         r.extend(e.accel_bias_m_s2[i].iter().map(|b| b * MGAL_PER_M_S2));
         r.extend(e.gyro_scale[i].iter().map(|s| s * PPM));
         r.extend(e.accel_scale[i].iter().map(|s| s * PPM));
-    })
+    })?;
+    Ok(n)
 }
 
 /// Writes state standard deviations in KF-GINS's `KF_GINS_STD.txt` format (22 columns).
-pub fn write_kfgins_std(w: impl Write, name: &str, s: &NavStd) -> Result<(), LogError> {
+pub fn write_kfgins_std(mut w: impl Write, name: &str, s: &NavStd) -> Result<(), LogError> {
+    append_std(&mut w, name, s, 0)?;
+    w.flush().map_err(|e| io_error(name, e))
+}
+
+fn append_std(
+    w: &mut impl Write,
+    name: &str,
+    s: &NavStd,
+    first_row: usize,
+) -> Result<usize, LogError> {
     let n = common_len(&[
         ("time_s", s.time_s.len()),
         ("pos_ned_m", s.pos_ned_m.len()),
@@ -681,7 +860,7 @@ pub fn write_kfgins_std(w: impl Write, name: &str, s: &NavStd) -> Result<(), Log
         ("accel_scale", s.accel_scale.len()),
     ])
     .map_err(|m| lens_err(name, m))?;
-    write_rows(w, name, n, |i, r| {
+    write_rows(w, name, n, first_row, |i, r| {
         r.push(s.time_s[i]);
         r.extend_from_slice(&s.pos_ned_m[i]);
         r.extend_from_slice(&s.vel_ned_m_s[i]);
@@ -690,7 +869,72 @@ pub fn write_kfgins_std(w: impl Write, name: &str, s: &NavStd) -> Result<(), Log
         r.extend(s.accel_bias_m_s2[i].iter().map(|b| b * MGAL_PER_M_S2));
         r.extend(s.gyro_scale[i].iter().map(|v| v * PPM));
         r.extend(s.accel_scale[i].iter().map(|v| v * PPM));
-    })
+    })?;
+    Ok(n)
+}
+
+/// KF-GINS's three output files, written block by block — e.g. on one thread while a
+/// filter on another produces the blocks ([`crate::nav::filter::run_forward_observed`]).
+pub struct KfGinsOutputWriter {
+    files: [std::io::BufWriter<std::fs::File>; 3],
+    paths: [PathBuf; 3],
+    names: [String; 3],
+    rows: usize,
+    gps_week: u16,
+}
+
+impl KfGinsOutputWriter {
+    /// Creates (truncates) the three files in `dir` (KF-GINS's `outputpath`, which must
+    /// exist, as in KF-GINS).
+    pub fn create(dir: impl AsRef<Path>, gps_week: u16) -> Result<Self, LogError> {
+        let dir = dir.as_ref();
+        let paths = [
+            dir.join(NAV_FILE),
+            dir.join(IMU_ERR_FILE),
+            dir.join(STD_FILE),
+        ];
+        let create = |p: &Path| {
+            std::fs::File::create(p)
+                .map(|f| std::io::BufWriter::with_capacity(1 << 20, f))
+                .map_err(|e| io_error(&p.display().to_string(), e))
+        };
+        Ok(KfGinsOutputWriter {
+            files: [create(&paths[0])?, create(&paths[1])?, create(&paths[2])?],
+            names: [0, 1, 2].map(|k| paths[k].display().to_string()),
+            paths,
+            rows: 0,
+            gps_week,
+        })
+    }
+
+    /// Appends one block of rows (all three parts the same length).
+    pub fn append(
+        &mut self,
+        sol: &NavSolution,
+        imu_err: &ImuErrors,
+        std: &NavStd,
+    ) -> Result<(), LogError> {
+        let [nav_w, err_w, std_w] = &mut self.files;
+        let n = append_nav(nav_w, &self.names[0], sol, self.gps_week, self.rows)?;
+        let m = append_imu_err(err_w, &self.names[1], imu_err, self.rows)?;
+        let k = append_std(std_w, &self.names[2], std, self.rows)?;
+        if n != m || n != k {
+            return Err(lens_err(
+                &self.names[0],
+                format!("blocks of {n} solution, {m} IMU-error and {k} std rows"),
+            ));
+        }
+        self.rows += n;
+        Ok(())
+    }
+
+    /// Flushes the files and returns their paths: `.nav`, IMU error, std.
+    pub fn finish(mut self) -> Result<[PathBuf; 3], LogError> {
+        for (w, name) in self.files.iter_mut().zip(&self.names) {
+            w.flush().map_err(|e| io_error(name, e))?;
+        }
+        Ok(self.paths)
+    }
 }
 
 /// Writes KF-GINS's three output files into `dir` (KF-GINS's `outputpath`, which must
@@ -742,6 +986,48 @@ mod tests {
 456300.005, 1.1e-5, -2.1e-5, 3.1e-5, 0.0011, -0.0021, 0.0491
 \t456300.010\t1.2e-5\t-2.2e-5\t3.2e-5\t0.0012\t-0.0022\t0.0492\r
 ";
+
+    #[test]
+    fn imu_blocks_parse_as_one() {
+        let mut text = String::new();
+        for i in 0..200 {
+            if i % 17 == 3 {
+                text.push_str("  \n");
+            }
+            text.push_str(&format!(
+                "{:.3} {} -2e-5 3e-5, 0.001 -0.002 0.049\n",
+                100.0 + 0.005 * i as f64,
+                1e-5 * i as f64
+            ));
+        }
+        let whole = read_imu_in_blocks(text.as_bytes(), "i", 1 << 30).unwrap();
+        for block in [1, 7, 64, 333] {
+            let parts = read_imu_in_blocks(text.as_bytes(), "i", block).unwrap();
+            assert_eq!(parts, whole, "block size {block}");
+        }
+        assert_eq!(whole.len(), 200);
+        // Errors: the first in file order, whatever the block size; a time-order error
+        // across a block boundary is found.
+        let lines: Vec<&str> = text.lines().collect();
+        let mut bad = lines.clone();
+        bad[150] = "oops";
+        let swapped_a = lines[60].to_string();
+        let mut bad2 = lines.clone();
+        bad2[60] = lines[61];
+        bad2[61] = &swapped_a;
+        for (t, want) in [(bad.join("\n"), "i:151:5"), (bad2.join("\n"), "i:62")] {
+            let whole = read_imu_in_blocks(t.as_bytes(), "i", 1 << 30)
+                .unwrap_err()
+                .to_string();
+            assert!(whole.contains(want), "{whole}");
+            for block in [1, 7, 64, 333] {
+                let e = read_imu_in_blocks(t.as_bytes(), "i", block)
+                    .unwrap_err()
+                    .to_string();
+                assert_eq!(e, whole, "block size {block}");
+            }
+        }
+    }
 
     #[test]
     fn imu_reads_all_separators() {

@@ -25,9 +25,9 @@ pub mod types;
 
 pub use gpstime::GpsTime;
 pub use kfgins::{
-    GnssReadOptions, ZeroSigma, read_kfgins_gnss, read_kfgins_gnss_file, read_kfgins_imu,
-    read_kfgins_imu_file, write_kfgins_gnss, write_kfgins_imu, write_kfgins_imu_err,
-    write_kfgins_nav, write_kfgins_outputs, write_kfgins_std,
+    GnssReadOptions, KfGinsOutputWriter, ZeroSigma, read_kfgins_gnss, read_kfgins_gnss_file,
+    read_kfgins_imu, read_kfgins_imu_file, write_kfgins_gnss, write_kfgins_imu,
+    write_kfgins_imu_err, write_kfgins_nav, write_kfgins_outputs, write_kfgins_std,
 };
 pub use kfgins_config::{ImuNoise, KfGinsConfig, KfGinsConfigRaw};
 pub use rtklib::{
@@ -70,8 +70,16 @@ pub(crate) struct Field<'a> {
 /// Splits a line on any of `seps`, skipping empty pieces (as KF-GINS's loader does with
 /// `", \t"`), and records each field's 1-based byte column.
 pub(crate) fn split_fields<'a>(line: &'a str, seps: &[u8]) -> Vec<Field<'a>> {
-    let bytes = line.as_bytes();
     let mut out = Vec::new();
+    split_fields_into(line, seps, &mut out);
+    out
+}
+
+/// [`split_fields`] into a reused vector (cleared first).
+#[inline]
+pub(crate) fn split_fields_into<'a>(line: &'a str, seps: &[u8], out: &mut Vec<Field<'a>>) {
+    out.clear();
+    let bytes = line.as_bytes();
     let mut start: Option<usize> = None;
     for (i, b) in bytes.iter().enumerate() {
         if seps.contains(b) {
@@ -91,7 +99,6 @@ pub(crate) fn split_fields<'a>(line: &'a str, seps: &[u8]) -> Vec<Field<'a>> {
             text: &line[s..],
         });
     }
-    out
 }
 
 /// Parses a finite f64 from one field; `field` is the 1-based field number, `name` the

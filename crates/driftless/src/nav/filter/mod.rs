@@ -42,7 +42,9 @@ pub use align::{
 };
 pub use eskf::{Eskf, UpdateKind, UpdateOutcome};
 pub use model::{FilterConfig, GaussMarkov, ImuNoise, QualityScale, Transition};
-pub use run::{EpochRecord, ForwardRun, InitialState, UpdateRecord, run_forward};
+pub use run::{
+    EpochRecord, ForwardRun, InitialState, UpdateRecord, run_forward, run_forward_observed,
+};
 pub use smoother::{SmoothedEpoch, SmoothedRun, smooth, smooth_with_covariances};
 pub use state::{N_STATES, SensorErrors};
 

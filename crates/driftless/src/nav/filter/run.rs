@@ -335,6 +335,24 @@ pub fn run_forward(
     init: InitialState,
     cfg: &FilterConfig,
 ) -> Result<ForwardRun, NavError> {
+    run_forward_observed(imu, gnss, init, cfg, &mut |_: &[EpochRecord]| {})
+}
+
+/// Epoch records are handed to the observer of [`run_forward_observed`] in blocks of at
+/// least this many.
+pub const OBSERVER_BLOCK: usize = 4096;
+
+/// [`run_forward`], handing the epoch records to `observer` while the filter runs: in
+/// order, each exactly once, in blocks of at least [`OBSERVER_BLOCK`] records once they
+/// are final (no later update at their epoch can change them), the last block at the
+/// end. Lets a caller write outputs on another thread while the filter runs.
+pub fn run_forward_observed(
+    imu: &[ImuIncrement],
+    gnss: &GnssFixes,
+    init: InitialState,
+    cfg: &FilterConfig,
+    observer: &mut dyn FnMut(&[EpochRecord]),
+) -> Result<ForwardRun, NavError> {
     cfg.validate()?;
     check_gnss(gnss)?;
     let t0 = init.nav.time_s;
@@ -408,6 +426,7 @@ pub fn run_forward(
         g += 1;
     }
     let mut t_prev = t0;
+    let mut observed = 0;
     for inc in &imu[start..] {
         let t_end = inc.time_s;
         let dt = t_end - t_prev;
@@ -476,7 +495,14 @@ pub fn run_forward(
             aids.after_epoch(&mut f, &raw, &mut ctx)?;
         }
         t_prev = t_end;
+        // Only the newest record can still change (updates at its epoch).
+        let settled = ctx.run.epochs.len() - 1;
+        if settled - observed >= OBSERVER_BLOCK {
+            observer(&ctx.run.epochs[observed..settled]);
+            observed = settled;
+        }
     }
+    observer(&ctx.run.epochs[observed..]);
     ctx.run.gnss_skipped += ng - g;
     if let Some(d) = aids.detector {
         ctx.run.standstills = d.finish();
