@@ -12,8 +12,8 @@ use driftless::io::nav::read_kfgins_imu_file;
 use driftless::nav::filter::model::{FilterConfig, GaussMarkov, ImuNoise};
 use driftless::nav::outage::OutageSpec;
 use driftless::nav::pipeline::{
-    GnssOutsideImu, ImuStreamOptions, TaggedCsvOptions, imu_from_kfgins, imu_from_tagged_csv_files,
-    read_gnss_file, select_gnss,
+    GnssOutsideImu, ImuGapPolicy, ImuStreamOptions, RateChannels, TaggedCsvOptions,
+    imu_from_kfgins, imu_from_rates_log, imu_from_tagged_csv_files, read_gnss_file, select_gnss,
 };
 use driftless::nav::session::{SessionConfig, consumer_mems_noise, run_session, solution_records};
 use std::path::PathBuf;
@@ -24,6 +24,11 @@ pub enum ImuFormat {
     Kfgins,
     /// RTKLIB-tagged CSV (acc [g], gyro [deg/s], tick [ms]) with a `.tag` file.
     TaggedCsv,
+    /// Generic delimited text (or DRIFTLOG) of rates: a time column (the first unless
+    /// `--time-column`) in GPS seconds and
+    /// three angular-rate and three specific-force columns, units from the header
+    /// (`gyro_x [deg/s]`) or the input options below; Δθ = ω·Δt, Δv = f·Δt.
+    Csv,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -82,6 +87,12 @@ pub struct NavArgs {
     /// Machine-readable summary.
     #[arg(long)]
     pub json: bool,
+    /// How to read a generic CSV IMU file (`--imu-format csv`).
+    #[command(
+        flatten,
+        next_help_heading = "Generic CSV IMU input (--imu-format csv)"
+    )]
+    pub input: crate::input::InputArgs,
 }
 
 fn parse_vec3(s: &str, what: &str) -> Result<[f64; 3]> {
@@ -130,6 +141,17 @@ pub fn run(a: NavArgs) -> Result<()> {
                 None => TaggedCsvOptions::default(),
             };
             imu_from_tagged_csv_files(&imu_file, &tag, &opts)?
+        }
+        ImuFormat::Csv => {
+            // Navigation needs time stamps: the first column unless told otherwise.
+            let mut input = a.input.clone();
+            input.time_column.get_or_insert_with(|| "1".into());
+            let log = input.read(&imu_file)?;
+            imu_from_rates_log(
+                &log,
+                &RateChannels::ByQuantity,
+                &ImuStreamOptions::default(),
+            )?
         }
     };
     let gnss = read_gnss_file(&gnss_file, &GnssReadOptions::default())?;
@@ -320,11 +342,29 @@ pub fn kf_gins_job(path: &std::path::Path, outages: &str, verbose: bool) -> Resu
         }
     }
     let inc = read_kfgins_imu_file(&k.imu_path)?;
+    // KF-GINS integrates across missing IMU samples; so does this job, and says so.
     let imu = imu_from_kfgins(
         &inc,
         &k.imu_path.display().to_string(),
-        &ImuStreamOptions::default(),
+        &ImuStreamOptions {
+            gap_policy: ImuGapPolicy::Bridge,
+            ..ImuStreamOptions::default()
+        },
     )?;
+    if verbose {
+        for g in imu.gaps.iter().take(20) {
+            eprintln!(
+                "note: {}: IMU gap of {:.4} s before t = {:.4} s (epoch {}): integrated across, as KF-GINS does",
+                k.imu_path.display(),
+                g.gap_s,
+                g.time_s,
+                g.index + 1
+            );
+        }
+        if imu.gaps.len() > 20 {
+            eprintln!("note: … {} more IMU gaps", imu.gaps.len() - 20);
+        }
+    }
     let gnss = read_kfgins_gnss_file(&k.gnss_path, &GnssReadOptions::default())?;
     let max3 = |v: [f64; 3]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let n = &k.imu_noise;
@@ -341,6 +381,9 @@ pub fn kf_gins_job(path: &std::path::Path, outages: &str, verbose: bool) -> Resu
         accel_scale: gm(n.accel_scale_std),
     };
     let mut cfg = FilterConfig::new(noise, k.antenna_lever_frd_m);
+    if let Some(longest) = imu.gaps.iter().map(|g| g.gap_s).reduce(f64::max) {
+        cfg.max_gap_factor = cfg.max_gap_factor.max(1.01 * longest / imu.nominal_dt_s);
+    }
     let spec: OutageSpec = outages.parse().context("--outages")?;
     if spec != OutageSpec::None {
         let sel = select_gnss(&gnss, &imu, &spec, GnssOutsideImu::Drop)?;

@@ -8,7 +8,8 @@
 //!   GNSS epoch with a velocity and a horizontal speed above `min_speed_m_s`: heading from
 //!   the course over ground, pitch from the climb angle, roll 0 (a land vehicle without
 //!   sideslip, IMU axes already rotated into the vehicle frame), position from the fix
-//!   moved from the antenna to the IMU by the lever arm, velocity from GNSS.
+//!   moved from the antenna to the IMU by the lever arm, velocity from GNSS — or, for
+//!   position-only GNSS, the central difference of the neighbouring fixes (σ 0.3 m/s).
 //! * **Evaluation**: the reference is the GNSS fixes themselves (on `drive_0708` an RTK
 //!   solution, cm level). The full-GNSS accuracy is the one-step prediction error at each
 //!   accepted fix — the horizontal innovation, i.e. the filter's antenna position *before*
@@ -257,11 +258,19 @@ pub fn initialise_in_motion(
     cfg: &SessionConfig,
     primed_gyro_bias: Option<Vec3>,
 ) -> Result<InitialState, NavError> {
-    let vel = gnss.vel_ned_m_s.as_ref().ok_or_else(|| {
-        NavError::Config(
-            "in-motion initialisation needs GNSS velocity (e.g. RTKLIB .pos with vn/ve/vu)".into(),
-        )
-    })?;
+    // GNSS velocity, or the central difference of the neighbouring fixes (≤ 2.5 s apart
+    // on each side) for position-only GNSS.
+    let derived: Vec<Option<Vec3>>;
+    let vel: Vec<Option<Vec3>> = match gnss.vel_ned_m_s.as_ref() {
+        Some(v) => v.iter().map(|&v| Some(v)).collect(),
+        None => {
+            derived = (0..gnss.time_s.len())
+                .map(|i| velocity_from_fixes(gnss, i, 2.5))
+                .collect();
+            derived
+        }
+    };
+    let vel_sigma = if gnss.vel_ned_m_s.is_some() { 0.1 } else { 0.3 };
     let imu_start = imu
         .epochs
         .first()
@@ -276,11 +285,12 @@ pub fn initialise_in_motion(
     let i = (0..gnss.time_s.len())
         .find(|&i| {
             let t = gnss.time_s[i];
-            let v = vel[i];
-            t > imu_start + 0.05
-                && t < imu_end - 1.0
-                && !in_outage(t)
-                && v[0].hypot(v[1]) > cfg.min_speed_m_s
+            vel[i].is_some_and(|v| {
+                t > imu_start + 0.05
+                    && t < imu_end - 1.0
+                    && !in_outage(t)
+                    && v[0].hypot(v[1]) > cfg.min_speed_m_s
+            })
         })
         .ok_or_else(|| {
             NavError::Config(format!(
@@ -289,7 +299,11 @@ pub fn initialise_in_motion(
                 cfg.min_speed_m_s
             ))
         })?;
-    let v = vel[i];
+    let Some(v) = vel[i] else {
+        return Err(NavError::Config(
+            "no GNSS velocity at the chosen epoch".into(),
+        ));
+    };
     let horiz = v[0].hypot(v[1]);
     let att = Euler {
         roll_rad: 0.0,
@@ -331,10 +345,30 @@ pub fn initialise_in_motion(
         nav,
         sensors,
         sigma_pos_ned_m: [sp[0].max(0.05), sp[1].max(0.05), sp[2].max(0.1)],
-        sigma_vel_ned_m_s: [0.1, 0.1, 0.1],
+        sigma_vel_ned_m_s: [vel_sigma; 3],
         sigma_att_rad: [2f64.to_radians(), 2f64.to_radians(), 3f64.to_radians()],
         sigma_sensors,
     })
+}
+
+/// NED velocity at fix `i` from the central difference of fixes `i − 1` and `i + 1`
+/// (second-order accurate in the spacing when the fixes are evenly spaced), when both
+/// neighbours exist within `max_gap_s`.
+fn velocity_from_fixes(gnss: &GnssFixes, i: usize, max_gap_s: f64) -> Option<Vec3> {
+    let (a, b) = (i.checked_sub(1)?, i + 1);
+    if b >= gnss.time_s.len() {
+        return None;
+    }
+    let (ta, t, tb) = (gnss.time_s[a], gnss.time_s[i], gnss.time_s[b]);
+    if !(t - ta > 0.0 && t - ta <= max_gap_s && tb - t > 0.0 && tb - t <= max_gap_s) {
+        return None;
+    }
+    let d = ned_offset_m(
+        (gnss.lat_rad[a], gnss.lon_rad[a], gnss.height_m[a]),
+        (gnss.lat_rad[b], gnss.lon_rad[b], gnss.height_m[b]),
+    );
+    let v = scale(d, 1.0 / (tb - ta));
+    v.iter().all(|x| x.is_finite()).then_some(v)
 }
 
 /// Antenna position of a record, (lat, lon, h).
