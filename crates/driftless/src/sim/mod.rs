@@ -3,7 +3,10 @@
 //! * [`rng`]: seedable xoshiro256++ generator with a ziggurat standard normal.
 //! * [`noise`]: static IMU noise (quantization, white, bias instability, rate random walk,
 //!   rate ramp, Gauss-Markov, turn-on bias) following IEEE Std 952-1997 Annex C.
+//! * [`gnss`]: GNSS fixes at the antenna of a trajectory (lever arm, σ, quality flags,
+//!   outage windows).
 
+pub mod gnss;
 pub mod ideal_imu;
 pub mod noise;
 pub mod rng;

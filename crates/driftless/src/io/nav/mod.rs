@@ -32,7 +32,7 @@ pub use kfgins::{
 pub use kfgins_config::{ImuNoise, KfGinsConfig, KfGinsConfigRaw};
 pub use rtklib::{
     FposSize, TaggedTimes, TickMapping, TimeTag, map_ticks_to_gps, read_rtklib_pos,
-    read_rtklib_pos_file, read_rtklib_tag, read_rtklib_tag_file,
+    read_rtklib_pos_file, read_rtklib_tag, read_rtklib_tag_file, write_rtklib_pos,
 };
 pub use types::{GnssFixes, ImuErrors, ImuIncrements, NavSolution, NavStd, quality};
 

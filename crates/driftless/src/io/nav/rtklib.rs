@@ -594,6 +594,127 @@ pub fn map_ticks_to_gps(
     })
 }
 
+/// Writes fixes as an RTKLIB `.pos` file (GPST, `WWWW SSSSSS.sss` time, latitude and
+/// longitude in degrees, ellipsoidal height, `Q`, `ns`, σ north/east/up, zero
+/// cross-covariances, age 0, ratio 0, and the velocity block when `g` has velocities),
+/// laid out as RTKLIB's `outsols` does; [`read_rtklib_pos`] reads it back. Time goes to
+/// 1 ms, angles to 1e-9 deg (0.1 mm), heights and σ to 0.1 mm.
+pub fn write_rtklib_pos(
+    mut w: impl std::io::Write,
+    name: &str,
+    g: &GnssFixes,
+    program: &str,
+) -> Result<(), LogError> {
+    use std::io::Write as _;
+    let n = super::types::common_len(&[
+        ("time_s", g.time_s.len()),
+        ("lat_rad", g.lat_rad.len()),
+        ("lon_rad", g.lon_rad.len()),
+        ("height_m", g.height_m.len()),
+        ("sigma_ned_m", g.sigma_ned_m.len()),
+        ("quality", g.quality.len()),
+    ])
+    .map_err(|message| LogError::InvalidLog {
+        at: Location::input(name),
+        message,
+    })?;
+    let vel = match (&g.vel_ned_m_s, &g.sigma_vel_ned_m_s) {
+        (Some(v), Some(s)) if v.len() == n && s.len() == n => Some((v, s)),
+        (None, _) => None,
+        _ => {
+            return Err(LogError::InvalidLog {
+                at: Location::input(name),
+                message: "velocities without matching σ or of another length".into(),
+            });
+        }
+    };
+    let io = |error| LogError::Io {
+        path: name.to_owned(),
+        error,
+    };
+    let week = g.gps_week.unwrap_or(0);
+    writeln!(w, "% program   : {program}").map_err(io)?;
+    writeln!(w, "% pos mode  : simulated").map_err(io)?;
+    writeln!(w, "% (lat/lon/height=WGS84/ellipsoidal,Q=1:fix,2:float,3:sbas,4:dgps,5:single,6:ppp,ns=# of satellites)").map_err(io)?;
+    write!(
+        w,
+        "%  GPST                  latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)   sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio"
+    )
+    .map_err(io)?;
+    if vel.is_some() {
+        write!(
+            w,
+            "    vn(m/s)    ve(m/s)    vu(m/s)      sdvn     sdve     sdvu    sdvne    sdveu    sdvun"
+        )
+        .map_err(io)?;
+    }
+    writeln!(w).map_err(io)?;
+    for i in 0..n {
+        let s = g.sigma_ned_m[i];
+        let vals = [
+            g.time_s[i],
+            g.lat_rad[i],
+            g.lon_rad[i],
+            g.height_m[i],
+            s[0],
+            s[1],
+            s[2],
+        ];
+        if let Some(v) = vals.iter().find(|v| !v.is_finite()) {
+            return Err(LogError::InvalidLog {
+                at: Location::input(name),
+                message: format!("non-finite value {v} in fix {i}"),
+            });
+        }
+        let ns = g
+            .n_sats
+            .as_ref()
+            .and_then(|v| v.get(i))
+            .copied()
+            .unwrap_or(0);
+        // seconds of week may pass 604 800 within one file: carry into the week
+        let wk_carry = (g.time_s[i] / 604_800.0).floor();
+        let sow = g.time_s[i] - wk_carry * 604_800.0;
+        write!(
+            w,
+            "{:4} {:10.3} {:14.9} {:14.9} {:10.4} {:3} {:3} {:8.4} {:8.4} {:8.4} {:8.4} {:8.4} {:8.4} {:6.2} {:6.1}",
+            i64::from(week) + wk_carry as i64,
+            sow,
+            g.lat_rad[i].to_degrees(),
+            g.lon_rad[i].to_degrees(),
+            g.height_m[i],
+            g.quality[i],
+            ns,
+            s[0],
+            s[1],
+            s[2],
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0
+        )
+        .map_err(io)?;
+        if let Some((v, sv)) = vel {
+            let (v, sv) = (v[i], sv[i]);
+            if v.iter().chain(&sv).any(|x| !x.is_finite()) {
+                return Err(LogError::InvalidLog {
+                    at: Location::input(name),
+                    message: format!("non-finite velocity in fix {i}"),
+                });
+            }
+            write!(
+                w,
+                " {:10.5} {:10.5} {:10.5} {:9.5} {:8.5} {:8.5} {:8.5} {:8.5} {:8.5}",
+                v[0], v[1], -v[2], sv[0], sv[1], sv[2], 0.0, 0.0, 0.0
+            )
+            .map_err(io)?;
+        }
+        writeln!(w).map_err(io)?;
+    }
+    w.flush().map_err(io)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -859,5 +980,44 @@ mod tests {
             tag.ticks_ms.len(),
             o.time_s.last().unwrap() - t1
         );
+    }
+
+    #[test]
+    fn pos_writer_round_trips() {
+        let g = GnssFixes {
+            gps_week: Some(2345),
+            time_s: vec![356_400.0, 356_401.0, 604_800.5],
+            lat_rad: vec![0.531_3, 0.531_300_01, 0.531_300_02],
+            lon_rad: vec![1.997_9, 1.997_900_02, 1.997_900_04],
+            height_m: vec![21.5, 21.25, 21.125],
+            sigma_ned_m: vec![[0.01, 0.012, 0.03]; 3],
+            vel_ned_m_s: Some(vec![[1.5, -2.25, 0.125]; 3]),
+            sigma_vel_ned_m_s: Some(vec![[0.02, 0.02, 0.04]; 3]),
+            quality: vec![1, 2, 1],
+            n_sats: Some(vec![12, 11, 12]),
+        };
+        let mut buf = Vec::new();
+        write_rtklib_pos(&mut buf, "x.pos", &g, "test").unwrap();
+        let back = read_rtklib_pos(&buf, "x.pos", &GnssReadOptions::default()).unwrap();
+        assert_eq!(back.gps_week, Some(2345));
+        assert_eq!(back.time_s, g.time_s);
+        assert_eq!(back.quality, g.quality);
+        assert_eq!(back.n_sats, g.n_sats);
+        assert_eq!(back.sigma_ned_m, g.sigma_ned_m);
+        assert_eq!(back.vel_ned_m_s, g.vel_ned_m_s);
+        for i in 0..3 {
+            assert!((back.lat_rad[i] - g.lat_rad[i]).abs() < 1e-11);
+            assert!((back.lon_rad[i] - g.lon_rad[i]).abs() < 1e-11);
+            assert!((back.height_m[i] - g.height_m[i]).abs() < 1e-4);
+        }
+        let mut no_vel = g.clone();
+        no_vel.vel_ned_m_s = None;
+        no_vel.sigma_vel_ned_m_s = None;
+        let mut buf = Vec::new();
+        write_rtklib_pos(&mut buf, "x.pos", &no_vel, "test").unwrap();
+        let back = read_rtklib_pos(&buf, "x.pos", &GnssReadOptions::default()).unwrap();
+        assert!(back.vel_ned_m_s.is_none());
+        no_vel.height_m[1] = f64::NAN;
+        assert!(write_rtklib_pos(&mut Vec::new(), "x.pos", &no_vel, "t").is_err());
     }
 }
