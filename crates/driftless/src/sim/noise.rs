@@ -74,6 +74,33 @@ pub enum SimError {
         /// Why it was refused.
         why: &'static str,
     },
+    /// A recorded trajectory's input refused (too few points, non-increasing times,
+    /// non-finite values) or its fit failed.
+    #[error("recorded trajectory: {why}")]
+    Recorded {
+        /// What is wrong, with the offending index and value.
+        why: String,
+    },
+    /// A motion profile that is not valid TOML or does not have the expected keys
+    /// (unknown keys and wrong types are named by the TOML parser).
+    #[error("motion profile {name}: {message}")]
+    Profile {
+        /// File name or `<string>`.
+        name: String,
+        /// Parser message (with line and column where known).
+        message: String,
+    },
+    /// An impossible motion in a profile (`segment` is `None` for the `start` and
+    /// `mounting` tables).
+    #[error("motion profile: {}{key}: {why}", match segment { Some((i, kind)) => format!("segment[{i}] ({kind}): "), None => String::new() })]
+    Motion {
+        /// Index (from 0, in file order) and type of the `[[segment]]`.
+        segment: Option<(usize, &'static str)>,
+        /// Offending key, e.g. `radius_m` or `start.speed_m_s`.
+        key: &'static str,
+        /// Why the motion is impossible.
+        why: String,
+    },
 }
 
 /// First-order Gauss-Markov process parameters (stationary σ [u], correlation time T [s]).

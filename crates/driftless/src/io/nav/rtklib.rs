@@ -605,7 +605,6 @@ pub fn write_rtklib_pos(
     g: &GnssFixes,
     program: &str,
 ) -> Result<(), LogError> {
-    use std::io::Write as _;
     let n = super::types::common_len(&[
         ("time_s", g.time_s.len()),
         ("lat_rad", g.lat_rad.len()),
