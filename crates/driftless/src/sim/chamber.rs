@@ -1,0 +1,711 @@
+//! The thermal-chamber calibration protocol (seed paper §2.3, §3.2: soak method, −25 … 70 °C
+//! in 5 °C steps; six-position and rate-table tests per Titterton & Weston 2004, §8.3;
+//! IEEE Std 1293-2018) as a [`Trajectory`] plus a manifest of its segments.
+//!
+//! # Protocol
+//!
+//! For each set temperature, in order:
+//!
+//! 1. **soak**: static at the home attitude (level, x north, z down: "−z up") while the
+//!    chamber moves to the new set point and the sensor settles (first-order lag τ, see
+//!    [`super::temperature`]);
+//! 2. **six positions**, each a static dwell with one body axis pointing up:
+//!    −z (home), +z, +x, −x, +y, −y, joined by smooth rotations;
+//! 3. **rate table** for each axis k = x, y, z: rotate to "+k up" (the table axis is
+//!    vertical and the tested body axis is on it), spin up smoothly to +ω about body +k,
+//!    turn exactly `rate_revolutions` full revolutions at constant +ω (the "rate"
+//!    segment), spin down, spin up to −ω, the same number of revolutions at −ω, spin
+//!    down (back at "+k up" exactly);
+//! 4. rotate back to the home attitude.
+//!
+//! The IMU stays at a fixed location (no lever arm: the table rotates about the IMU),
+//! so the ideal specific force in every static position is exactly the normal gravity
+//! of the site along the up axis ([`ChamberManifest::gravity_m_s2`]). Over whole
+//! revolutions about a vertical axis, the horizontal Earth-rate components average to
+//! zero and the vertical one is the same for +ω and −ω, so the ±ω difference isolates the
+//! scale factor.
+//!
+//! # Attitude program
+//!
+//! Every piece is a rotation about a body-fixed unit axis u starting from an attitude
+//! C₀: C_bn(t) = C₀·R(u, θ(t)), R by Rodrigues' formula, so ω_nb^b = u·θ̇ exactly
+//! (Ċ_bn = C₀R[u×]θ̇ = C_bn[ω_nb^b×]). With s = (t − t₀)/T on a piece of duration T:
+//!
+//! * hold: θ = 0;
+//! * move through Θ: θ = Θ(s − sin(2πs)/(2π)), θ̇ = (Θ/T)(1 − cos 2πs) — rate and angular
+//!   acceleration are zero at both ends;
+//! * spin-up to ω: θ̇ = ω(1 − cos πs)/2, θ = ω(t − t₀)/2 − ωT sin(πs)/(2π);
+//!   spin: θ = ω(t − t₀); spin-down: θ̇ = ω(1 + cos πs)/2, θ = ω(t − t₀)/2 + ωT sin(πs)/(2π).
+//!
+//! ω_nb^b is therefore continuous everywhere (no infinite rates) and analytic inside each
+//! piece. Every piece lasts a whole number of samples and starts on the sample grid, so
+//! the 6-node Gauss–Legendre increments of [`super::ideal_imu::ideal_increment`] never
+//! straddle a piece boundary and stay exact to rounding; the constant rate is adjusted so
+//! that the spin segment is a whole number of samples long
+//! (ω = 2π·revolutions/(n·Δt), recorded in the manifest).
+//!
+//! # Manifest
+//!
+//! [`ChamberManifest`] lists every segment (time range, kind — soak / position (which
+//! axis up) / rate (axis, signed ω) / move — and set temperature) and serialises to TOML,
+//! so the thermal-calibration step can find the data of each test. Sample `i` of an
+//! increment log covers (iΔt, (i+1)Δt]; sample `i` of a rate log is at iΔt;
+//! [`Segment::sample_range`] returns the samples of a segment in either convention.
+
+use driftless_model::linalg::{Mat3, Vec3};
+use driftless_model::units::DEG;
+use serde::{Deserialize, Serialize};
+
+pub use super::chamber_manifest::{
+    BodyAxis, ChamberManifest, MANIFEST_VERSION, Segment, SegmentKind, SignedAxis,
+};
+use super::ideal_imu::{Trajectory, TrajectoryPoint};
+use super::sensor::{IdealImu, OutputKind, ideal_sample};
+use super::sensor_error::{SensorSimError, check_finite, check_pos};
+use super::temperature::{ChamberStep, TemperatureProfile};
+use crate::nav::attitude::Quat;
+use crate::nav::earth;
+
+/// Protocol settings (TOML-serialisable; every field has a default).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ChamberConfig {
+    /// Set temperatures in order, °C (default −25 … 70 in 5 °C steps, the paper's 20).
+    pub temperatures_c: Vec<f64>,
+    /// Soak dwell at the start of each step, s (default 3600).
+    pub soak_s: f64,
+    /// Dwell per static position, s (default 60).
+    pub position_dwell_s: f64,
+    /// Duration of each rotation between positions, s (default 10).
+    pub move_s: f64,
+    /// Rate-table rate |ω|, deg/s (default 50; adjusted to whole samples, see module docs).
+    pub rate_deg_s: f64,
+    /// Whole revolutions per rate segment (default 5).
+    pub rate_revolutions: u32,
+    /// Duration of each spin-up and spin-down, s (default 5).
+    pub spin_s: f64,
+    /// Sensor thermal time constant τ, s (default 300).
+    pub lag_tau_s: f64,
+    /// Chamber air ramp rate, °C/min (default: instantaneous set-point steps).
+    pub ramp_c_per_min: Option<f64>,
+    /// Sample rate, Hz (default 100).
+    pub sample_rate_hz: f64,
+    /// Site latitude, deg (default 51.08, Calgary, where the paper's chamber was).
+    pub latitude_deg: f64,
+    /// Site longitude, deg (default −114.13).
+    pub longitude_deg: f64,
+    /// Site ellipsoidal height, m (default 1100).
+    pub height_m: f64,
+}
+
+impl Default for ChamberConfig {
+    fn default() -> Self {
+        ChamberConfig {
+            temperatures_c: (0..20).map(|i| -25.0 + 5.0 * i as f64).collect(),
+            soak_s: 3600.0,
+            position_dwell_s: 60.0,
+            move_s: 10.0,
+            rate_deg_s: 50.0,
+            rate_revolutions: 5,
+            spin_s: 5.0,
+            lag_tau_s: 300.0,
+            ramp_c_per_min: None,
+            sample_rate_hz: 100.0,
+            latitude_deg: 51.08,
+            longitude_deg: -114.13,
+            height_m: 1100.0,
+        }
+    }
+}
+
+/// How θ evolves on a piece (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Motion {
+    Hold,
+    Move { angle_rad: f64 },
+    SpinUp { rate_rad_s: f64 },
+    Spin { rate_rad_s: f64 },
+    SpinDown { rate_rad_s: f64 },
+}
+
+/// One piece of the attitude program.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Piece {
+    start_s: f64,
+    duration_s: f64,
+    c0: Mat3,
+    axis: Vec3,
+    motion: Motion,
+}
+
+impl Piece {
+    /// (θ, θ̇) at `tau` seconds into the piece.
+    fn angle_rate(&self, tau: f64) -> (f64, f64) {
+        use std::f64::consts::{PI, TAU};
+        let t = self.duration_s;
+        match self.motion {
+            Motion::Hold => (0.0, 0.0),
+            Motion::Move { angle_rad } => {
+                let s = tau / t;
+                (
+                    angle_rad * (s - (TAU * s).sin() / TAU),
+                    angle_rad / t * (1.0 - (TAU * s).cos()),
+                )
+            }
+            Motion::SpinUp { rate_rad_s: w } => {
+                let s = tau / t;
+                (
+                    w * (0.5 * tau - t * (PI * s).sin() / TAU),
+                    0.5 * w * (1.0 - (PI * s).cos()),
+                )
+            }
+            Motion::Spin { rate_rad_s: w } => (w * tau, w),
+            Motion::SpinDown { rate_rad_s: w } => {
+                let s = tau / t;
+                (
+                    w * (0.5 * tau + t * (PI * s).sin() / TAU),
+                    0.5 * w * (1.0 + (PI * s).cos()),
+                )
+            }
+        }
+    }
+
+    /// (C_bn, ω_nb^b) at `tau` into the piece.
+    fn attitude(&self, tau: f64) -> (Mat3, Vec3) {
+        if self.motion == Motion::Hold {
+            return (self.c0, [0.0; 3]);
+        }
+        let (th, th_d) = self.angle_rate(tau);
+        let k = Mat3::skew(self.axis);
+        let (s, c) = th.sin_cos();
+        let r = Mat3::IDENTITY + k.scaled(s) + k.mul_mat(&k).scaled(1.0 - c);
+        (self.c0.mul_mat(&r), self.axis.map(|u| u * th_d))
+    }
+}
+
+/// The protocol's motion at a fixed site: a [`Trajectory`].
+#[derive(Clone, Debug)]
+pub struct ChamberTrajectory {
+    lat_rad: f64,
+    lon_rad: f64,
+    height_m: f64,
+    pieces: Vec<Piece>,
+}
+
+impl Trajectory for ChamberTrajectory {
+    fn point(&self, t_s: f64) -> TrajectoryPoint {
+        let i = self
+            .pieces
+            .partition_point(|p| p.start_s <= t_s)
+            .saturating_sub(1);
+        let (c_bn, omega) = match self.pieces.get(i) {
+            Some(p) => p.attitude((t_s - p.start_s).clamp(0.0, p.duration_s)),
+            None => (Mat3::IDENTITY, [0.0; 3]),
+        };
+        TrajectoryPoint {
+            lat_rad: self.lat_rad,
+            lon_rad: self.lon_rad,
+            height_m: self.height_m,
+            vel_ned_m_s: [0.0; 3],
+            acc_ned_m_s2: [0.0; 3],
+            c_bn,
+            omega_nb_b_rad_s: omega,
+        }
+    }
+}
+
+/// A built protocol: motion, segment manifest and the chamber temperature profile (all
+/// on the same time axis, t = 0 at the start of the first soak).
+#[derive(Clone, Debug)]
+pub struct ChamberProtocol {
+    /// The motion.
+    pub trajectory: ChamberTrajectory,
+    /// The segments.
+    pub manifest: ChamberManifest,
+    /// Chamber set points (one step per set temperature, lasting the whole step) with
+    /// the sensor lag.
+    pub temperature: TemperatureProfile,
+}
+
+impl ChamberProtocol {
+    /// Number of samples covering the whole run.
+    pub fn n_samples(&self) -> usize {
+        (self.manifest.duration_s * self.manifest.sample_rate_hz).round() as usize
+    }
+
+    /// Ideal IMU data of the whole run (parallel): rates at iΔt or increments over
+    /// (iΔt, (i+1)Δt], i = 0 … n − 1. A sample inside a static piece is the piece's
+    /// constant rates (× Δt for increments), evaluated once per piece; the others come
+    /// from [`super::sensor::ideal_sample`] (exact Gauss–Legendre increments).
+    pub fn ideal(&self, kind: OutputKind) -> IdealImu {
+        let fs = self.manifest.sample_rate_hz;
+        let dt = 1.0 / fs;
+        let first = match kind {
+            OutputKind::Rates => 0.0,
+            OutputKind::Increments => dt,
+        };
+        let tr = &self.trajectory;
+        // Per piece: (first sample index, end sample index, static rates).
+        type Span = (u64, u64, Option<(Vec3, Vec3)>);
+        let spans: Vec<Span> = tr
+            .pieces
+            .iter()
+            .map(|p| {
+                let k0 = (p.start_s * fs).round() as u64;
+                let k1 = if p.duration_s.is_finite() {
+                    ((p.start_s + p.duration_s) * fs).round() as u64
+                } else {
+                    u64::MAX
+                };
+                let rates = (p.motion == Motion::Hold).then(|| tr.point(p.start_s).imu_rates());
+                (k0, k1, rates)
+            })
+            .collect();
+        let w = match kind {
+            OutputKind::Rates => 1.0,
+            OutputKind::Increments => dt,
+        };
+        IdealImu::from_fn(kind, first, dt, self.n_samples(), |k| {
+            // Rate sample k is at kΔt, increment k covers (kΔt, (k+1)Δt]: either lies
+            // in a piece [k0Δt, k1Δt] when k0 ≤ k < k1.
+            let k = k as u64;
+            let i = spans.partition_point(|s| s.0 <= k).saturating_sub(1);
+            match spans.get(i) {
+                Some(&(k0, k1, Some((g, f)))) if k0 <= k && k < k1 => {
+                    (g.map(|v| v * w), f.map(|v| v * w))
+                }
+                _ => ideal_sample(tr, kind, first + k as f64 * dt, dt),
+            }
+        })
+    }
+}
+
+/// Builds the piece list and the manifest on a whole-sample grid.
+struct Builder {
+    dt: f64,
+    k: u64,
+    c: Mat3,
+    set_c: f64,
+    pieces: Vec<Piece>,
+    segments: Vec<Segment>,
+}
+
+impl Builder {
+    fn push(&mut self, n: u64, axis: Vec3, motion: Motion, end: Mat3, kind: SegmentKind) {
+        let start_s = self.k as f64 * self.dt;
+        let end_s = (self.k + n) as f64 * self.dt;
+        self.pieces.push(Piece {
+            start_s,
+            duration_s: end_s - start_s,
+            c0: self.c,
+            axis,
+            motion,
+        });
+        match self.segments.last_mut() {
+            // Consecutive transitions at the same set point form one "move" segment.
+            Some(last)
+                if kind == SegmentKind::Move
+                    && last.kind == SegmentKind::Move
+                    && last.set_temperature_c == self.set_c
+                    && last.end_s == start_s =>
+            {
+                last.end_s = end_s;
+            }
+            _ => self.segments.push(Segment {
+                start_s,
+                end_s,
+                set_temperature_c: self.set_c,
+                kind,
+            }),
+        }
+        self.k += n;
+        self.c = end;
+    }
+
+    fn hold(&mut self, n: u64, kind: SegmentKind) {
+        let c = self.c;
+        self.push(n, [0.0, 0.0, 1.0], Motion::Hold, c, kind);
+    }
+
+    /// Smooth rotation to attitude `to` (skipped if already there).
+    fn move_to(&mut self, n: u64, to: Mat3) {
+        let rel = self.c.t().mul_mat(&to);
+        let phi = Quat::from_dcm(&rel).to_rotation_vector();
+        let angle = (phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]).sqrt();
+        if angle < 1e-12 {
+            self.c = to;
+            return;
+        }
+        let axis = phi.map(|v| v / angle);
+        self.push(
+            n,
+            axis,
+            Motion::Move { angle_rad: angle },
+            to,
+            SegmentKind::Move,
+        );
+    }
+}
+
+impl ChamberConfig {
+    /// Check the settings.
+    pub fn validate(&self) -> Result<(), SensorSimError> {
+        if self.temperatures_c.is_empty() {
+            return Err(SensorSimError::invalid(
+                "chamber.temperatures_c (empty)",
+                "needs at least one set temperature",
+            ));
+        }
+        for (i, &t) in self.temperatures_c.iter().enumerate() {
+            check_finite(&format!("chamber.temperatures_c[{i}]"), t)?;
+        }
+        check_pos("chamber.sample_rate_hz", self.sample_rate_hz)?;
+        check_pos("chamber.soak_s", self.soak_s)?;
+        check_pos("chamber.position_dwell_s", self.position_dwell_s)?;
+        check_pos("chamber.move_s", self.move_s)?;
+        check_pos("chamber.rate_deg_s", self.rate_deg_s)?;
+        check_pos("chamber.spin_s", self.spin_s)?;
+        check_pos("chamber.lag_tau_s", self.lag_tau_s)?;
+        if self.rate_revolutions == 0 {
+            return Err(SensorSimError::invalid(
+                "chamber.rate_revolutions = 0",
+                "must be at least 1",
+            ));
+        }
+        if !self.latitude_deg.is_finite() || self.latitude_deg.abs() >= 90.0 {
+            return Err(SensorSimError::invalid(
+                format!("chamber.latitude_deg = {}", self.latitude_deg),
+                "must be finite and within (-90, 90)",
+            ));
+        }
+        check_finite("chamber.longitude_deg", self.longitude_deg)?;
+        check_finite("chamber.height_m", self.height_m)?;
+        if let Some(r) = self.ramp_c_per_min {
+            check_pos("chamber.ramp_c_per_min", r)?;
+            let mut prev = self.temperatures_c[0];
+            for &t in &self.temperatures_c {
+                let d = (t - prev).abs() / r * 60.0;
+                if d > self.soak_s {
+                    return Err(SensorSimError::invalid(
+                        format!("chamber.soak_s = {}", self.soak_s),
+                        format!(
+                            "shorter than the {d} s ramp from {prev} °C to {t} °C at {r} °C/min"
+                        ),
+                    ));
+                }
+                prev = t;
+            }
+        }
+        // Every duration must be at least one sample.
+        for (name, d) in [
+            ("soak_s", self.soak_s),
+            ("position_dwell_s", self.position_dwell_s),
+            ("move_s", self.move_s),
+            ("spin_s", self.spin_s),
+        ] {
+            if (d * self.sample_rate_hz).round() < 1.0 {
+                return Err(SensorSimError::invalid(
+                    format!("chamber.{name} = {d}"),
+                    "shorter than one sample",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Build the protocol (module docs). Durations are rounded to whole samples.
+    pub fn build(&self) -> Result<ChamberProtocol, SensorSimError> {
+        self.validate()?;
+        let fs = self.sample_rate_hz;
+        let dt = 1.0 / fs;
+        let ns = |d: f64| ((d * fs).round() as u64).max(1);
+        let n_spin = ns(self.rate_revolutions as f64 * 360.0 / self.rate_deg_s);
+        let omega = self.rate_revolutions as f64 * std::f64::consts::TAU / (n_spin as f64 * dt);
+        let home = SignedAxis::POSITIONS[0].c_bn_up();
+        let mut b = Builder {
+            dt,
+            k: 0,
+            c: home,
+            set_c: self.temperatures_c[0],
+            pieces: Vec::new(),
+            segments: Vec::new(),
+        };
+        let mut steps = Vec::with_capacity(self.temperatures_c.len());
+        for &set_c in &self.temperatures_c {
+            let k_start = b.k;
+            b.set_c = set_c;
+            b.move_to(ns(self.move_s), home);
+            b.hold(ns(self.soak_s), SegmentKind::Soak);
+            for up in SignedAxis::POSITIONS {
+                b.move_to(ns(self.move_s), up.c_bn_up());
+                b.hold(ns(self.position_dwell_s), SegmentKind::Position { up });
+            }
+            for axis in BodyAxis::ALL {
+                let at = SignedAxis::new(axis, true).c_bn_up();
+                b.move_to(ns(self.move_s), at);
+                let u = axis.unit();
+                for w in [omega, -omega] {
+                    let c = b.c;
+                    let kind = SegmentKind::Rate {
+                        axis,
+                        rate_rad_s: w,
+                    };
+                    b.push(
+                        ns(self.spin_s),
+                        u,
+                        Motion::SpinUp { rate_rad_s: w },
+                        rotate(c, u, 0.5 * w * ns(self.spin_s) as f64 * dt),
+                        SegmentKind::Move,
+                    );
+                    let c = b.c;
+                    b.push(
+                        n_spin,
+                        u,
+                        Motion::Spin { rate_rad_s: w },
+                        rotate(c, u, w * n_spin as f64 * dt),
+                        kind,
+                    );
+                    // Back exactly at "+axis up" after the ±ω pair.
+                    let end = if w < 0.0 {
+                        at
+                    } else {
+                        rotate(b.c, u, 0.5 * w * ns(self.spin_s) as f64 * dt)
+                    };
+                    b.push(
+                        ns(self.spin_s),
+                        u,
+                        Motion::SpinDown { rate_rad_s: w },
+                        end,
+                        SegmentKind::Move,
+                    );
+                }
+            }
+            b.move_to(ns(self.move_s), home);
+            steps.push(ChamberStep {
+                set_c,
+                duration_s: (b.k - k_start) as f64 * dt,
+            });
+        }
+        // Hold at home after the end.
+        let end_s = b.k as f64 * dt;
+        b.pieces.push(Piece {
+            start_s: end_s,
+            duration_s: f64::INFINITY,
+            c0: home,
+            axis: [0.0, 0.0, 1.0],
+            motion: Motion::Hold,
+        });
+        let lat = self.latitude_deg * DEG;
+        let manifest = ChamberManifest {
+            format_version: MANIFEST_VERSION,
+            sample_rate_hz: fs,
+            latitude_deg: self.latitude_deg,
+            longitude_deg: self.longitude_deg,
+            height_m: self.height_m,
+            gravity_m_s2: earth::normal_gravity_m_s2(lat, self.height_m),
+            earth_rate_rad_s: earth::OMEGA_IE,
+            lag_tau_s: self.lag_tau_s,
+            duration_s: end_s,
+            segments: b.segments,
+        };
+        Ok(ChamberProtocol {
+            trajectory: ChamberTrajectory {
+                lat_rad: lat,
+                lon_rad: self.longitude_deg * DEG,
+                height_m: self.height_m,
+                pieces: b.pieces,
+            },
+            manifest,
+            temperature: TemperatureProfile::Chamber {
+                steps,
+                lag_tau_s: self.lag_tau_s,
+                initial_c: None,
+                ramp_c_per_min: self.ramp_c_per_min,
+            },
+        })
+    }
+}
+
+/// C·R(u, θ).
+fn rotate(c: Mat3, u: Vec3, th: f64) -> Mat3 {
+    let k = Mat3::skew(u);
+    let (s, co) = th.sin_cos();
+    c.mul_mat(&(Mat3::IDENTITY + k.scaled(s) + k.mul_mat(&k).scaled(1.0 - co)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::ideal_imu::FiniteDifference;
+    use super::*;
+
+    fn small() -> ChamberConfig {
+        ChamberConfig {
+            temperatures_c: vec![-5.0, 0.0],
+            soak_s: 20.0,
+            position_dwell_s: 3.0,
+            move_s: 2.0,
+            rate_deg_s: 90.0,
+            rate_revolutions: 1,
+            spin_s: 1.0,
+            lag_tau_s: 2.0,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn positions_put_the_named_axis_up() {
+        for up in SignedAxis::POSITIONS {
+            let c = up.c_bn_up();
+            assert_eq!(c.det(), 1.0);
+            let i = c.t().mul_mat(&c);
+            assert_eq!(i, Mat3::IDENTITY);
+            // f^b = C_nb·(0, 0, −g): +g on the up axis.
+            let f = c.t().mul_vec([0.0, 0.0, -1.0]);
+            assert_eq!(f, up.axis.unit().map(|v| v * up.sign()));
+            assert_eq!(up.to_string().parse::<SignedAxis>().unwrap(), up);
+        }
+        assert!("x".parse::<SignedAxis>().is_err());
+        assert!("+w".parse::<SignedAxis>().is_err());
+    }
+
+    #[test]
+    fn attitude_is_continuous_and_rates_match_finite_differences() {
+        let p = small().build().unwrap();
+        let tr = &p.trajectory;
+        // Continuity at every piece boundary.
+        for w in tr.pieces.windows(2) {
+            let t = w[1].start_s;
+            let (a, wa) = w[0].attitude(w[0].duration_s);
+            let (b, wb) = w[1].attitude(0.0);
+            for r in 0..3 {
+                for c in 0..3 {
+                    assert!((a.0[r][c] - b.0[r][c]).abs() < 1e-12, "t={t}");
+                }
+                assert!((wa[r] - wb[r]).abs() < 1e-12, "t={t}");
+            }
+        }
+        // ω_nb^b equals the finite-difference rate inside moves and spins.
+        let fd = FiniteDifference {
+            state: |t: f64| {
+                let q = tr.point(t);
+                (q.lat_rad, q.lon_rad, q.height_m, q.vel_ned_m_s, q.c_bn)
+            },
+            step_s: 1e-4,
+        };
+        let mut checked = 0;
+        for pc in &tr.pieces {
+            if pc.motion == Motion::Hold || !pc.duration_s.is_finite() {
+                continue;
+            }
+            let t = pc.start_s + 0.37 * pc.duration_s;
+            let (a, b) = (tr.point(t), fd.point(t));
+            for k in 0..3 {
+                assert!(
+                    (a.omega_nb_b_rad_s[k] - b.omega_nb_b_rad_s[k]).abs() < 1e-7,
+                    "{:?} {:?} {:?}",
+                    pc.motion,
+                    a.omega_nb_b_rad_s,
+                    b.omega_nb_b_rad_s
+                );
+            }
+            checked += 1;
+        }
+        assert!(checked > 20);
+    }
+
+    #[test]
+    fn static_shortcut_matches_quadrature() {
+        let p = small().build().unwrap();
+        for kind in [OutputKind::Rates, OutputKind::Increments] {
+            let fast = p.ideal(kind);
+            let dt = 1.0 / p.manifest.sample_rate_hz;
+            let first = if kind == OutputKind::Rates { 0.0 } else { dt };
+            let slow = IdealImu::from_trajectory(&p.trajectory, kind, first, dt, p.n_samples());
+            let scale = if kind == OutputKind::Rates { 10.0 } else { 0.1 };
+            for k in 0..p.n_samples() {
+                let (a, b) = (fast.gyro.at(k), slow.gyro.at(k));
+                let (c, d) = (fast.accel.at(k), slow.accel.at(k));
+                for i in 0..3 {
+                    assert!((a[i] - b[i]).abs() < 1e-15 * scale, "{kind:?} {k}");
+                    assert!((c[i] - d[i]).abs() < 1e-15 * scale, "{kind:?} {k}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn manifest_covers_the_run_and_round_trips() {
+        let p = small().build().unwrap();
+        let m = &p.manifest;
+        assert_eq!(m.set_temperatures_c(), vec![-5.0, 0.0]);
+        assert_eq!(m.segments[0].start_s, 0.0);
+        for w in m.segments.windows(2) {
+            assert_eq!(w[0].end_s, w[1].start_s);
+        }
+        assert_eq!(m.segments.last().map(|s| s.end_s), Some(m.duration_s));
+        for set in [-5.0, 0.0] {
+            for up in SignedAxis::POSITIONS {
+                let s = m.position(set, up).unwrap();
+                assert!((s.duration_s() - 3.0).abs() < 1e-9);
+            }
+            for axis in BodyAxis::ALL {
+                for pos in [true, false] {
+                    let s = m.rate(set, axis, pos).unwrap();
+                    let SegmentKind::Rate { rate_rad_s, .. } = s.kind else {
+                        panic!()
+                    };
+                    // Whole revolutions.
+                    let revs = rate_rad_s.abs() * s.duration_s() / std::f64::consts::TAU;
+                    assert!((revs - 1.0).abs() < 1e-12);
+                }
+            }
+        }
+        let text = m.to_toml_string().unwrap();
+        assert!(text.contains("kind = \"position\"") && text.contains("up = \"+x\""));
+        let back = ChamberManifest::from_toml_str(&text).unwrap();
+        assert_eq!(&back, m);
+        let bad = text.replacen("kind = \"soak\"", "kind = \"soak\"\naxis = \"x\"", 1);
+        assert!(ChamberManifest::from_toml_str(&bad).is_err());
+        // Temperature steps span the segments of each set point.
+        let TemperatureProfile::Chamber { steps, .. } = &p.temperature else {
+            panic!()
+        };
+        let total: f64 = steps.iter().map(|s| s.duration_s).sum();
+        assert!((total - m.duration_s).abs() < 1e-9);
+    }
+
+    #[test]
+    fn rejects_bad_settings() {
+        let e = ChamberConfig {
+            lag_tau_s: 0.0,
+            ..small()
+        }
+        .build()
+        .unwrap_err();
+        assert!(e.to_string().contains("lag_tau_s = 0"), "{e}");
+        assert!(
+            ChamberConfig {
+                temperatures_c: vec![],
+                ..small()
+            }
+            .build()
+            .is_err()
+        );
+        assert!(
+            ChamberConfig {
+                rate_revolutions: 0,
+                ..small()
+            }
+            .build()
+            .is_err()
+        );
+        let e = ChamberConfig {
+            ramp_c_per_min: Some(1.0),
+            ..small()
+        }
+        .build()
+        .unwrap_err();
+        assert!(e.to_string().contains("ramp"), "{e}");
+        assert!(toml::from_str::<ChamberConfig>("soak = 10\n").is_err());
+    }
+}
