@@ -332,7 +332,8 @@ mod tests {
     #[test]
     fn bad_settings_are_named() {
         let traj = turn();
-        let cases: [(&str, fn(&mut GnssSimConfig)); 6] = [
+        type Edit = fn(&mut GnssSimConfig);
+        let cases: [(&str, Edit); 6] = [
             ("gnss.rate_hz", |c| c.rate_hz = 0.0),
             ("gnss.end_s", |c| c.end_s = -1.0),
             ("gnss.sigma_ned_m", |c| c.sigma_ned_m = [0.0; 3]),
