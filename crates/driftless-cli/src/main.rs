@@ -1,7 +1,8 @@
 //! `driftless` — from raw MEMS IMU logs to a navigation error budget.
 //!
 //! Subcommands: `allan` (noise analysis), `convert` (text ↔ compact binary log),
-//! `demo` (the whole issue-2 pipeline on built-in simulated data).
+//! `demo` (the whole issue-2 pipeline on built-in simulated data), `bench`, `nav`
+//! (GNSS/INS), `simulate` (scenario → IMU, GNSS and truth files).
 
 mod allan_cmd;
 mod bench_cmd;
@@ -10,6 +11,7 @@ mod demo_cmd;
 mod input;
 mod nav_cmd;
 mod output;
+mod simulate_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -36,6 +38,9 @@ enum Command {
     Bench(bench_cmd::BenchArgs),
     /// Loosely coupled GNSS/INS on recorded data, with simulated GNSS outages.
     Nav(nav_cmd::NavArgs),
+    /// Simulate IMU, GNSS and truth from a scenario file (trajectory, sensor errors,
+    /// temperature, GNSS).
+    Simulate(simulate_cmd::SimulateArgs),
     /// Simulate an 18-h static six-axis IMU log with known noise, analyse it, compare.
     Demo(demo_cmd::DemoArgs),
 }
@@ -48,6 +53,7 @@ fn main() -> ExitCode {
         Command::Demo(a) => demo_cmd::run(a),
         Command::Bench(a) => bench_cmd::run(a),
         Command::Nav(a) => nav_cmd::run(a),
+        Command::Simulate(a) => simulate_cmd::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

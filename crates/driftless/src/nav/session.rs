@@ -113,7 +113,9 @@ pub struct SessionResult {
     /// Gyro bias primed from the static start, if it was static.
     pub primed_gyro_bias_rad_s: Option<Vec3>,
     /// RMS horizontal one-step prediction error at accepted fixes outside the convergence
-    /// periods, m, and the number of fixes it covers.
+    /// periods (after the start, after each outage window and after each gap in the
+    /// GNSS data longer than three median fix intervals), m, and the number of fixes it
+    /// covers.
     pub horizontal_rms_m: Option<(f64, usize)>,
     /// Per-outage errors of the forward (real-time) filter.
     pub outages: Vec<OutageResult>,
@@ -154,12 +156,15 @@ pub fn run_session(
 
     // Full-GNSS accuracy: prior innovations at accepted position fixes.
     let t0 = init.nav.time_s;
+    let data_gaps = gnss_data_gaps(&used.time_s);
     let excluded = |t: f64| {
         t < t0 + cfg.converge_s
             || cfg
                 .outages
                 .iter()
-                .any(|w| t >= w.start_s && t <= w.end_s + cfg.reconverge_s)
+                .map(|w| (w.start_s, w.end_s))
+                .chain(data_gaps.iter().copied())
+                .any(|(a, b)| t >= a && t <= b + cfg.reconverge_s)
     };
     let mut sum2 = 0.0;
     let mut count = 0usize;
@@ -349,6 +354,22 @@ pub fn initialise_in_motion(
         sigma_att_rad: [2f64.to_radians(), 2f64.to_radians(), 3f64.to_radians()],
         sigma_sensors,
     })
+}
+
+/// Gaps in a GNSS time column longer than three median intervals, as (last fix before,
+/// first fix after), s: the fix after such a gap ends an outage of the data itself.
+fn gnss_data_gaps(time_s: &[f64]) -> Vec<(f64, f64)> {
+    let mut d: Vec<f64> = time_s.windows(2).map(|w| w[1] - w[0]).collect();
+    if d.is_empty() {
+        return Vec::new();
+    }
+    d.sort_by(f64::total_cmp);
+    let limit = 3.0 * d[d.len() / 2];
+    time_s
+        .windows(2)
+        .filter(|w| w[1] - w[0] > limit)
+        .map(|w| (w[0], w[1]))
+        .collect()
 }
 
 /// NED velocity at fix `i` from the central difference of fixes `i − 1` and `i + 1`

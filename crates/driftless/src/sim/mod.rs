@@ -27,6 +27,7 @@ pub mod presets;
 pub mod profile;
 pub mod recorded;
 pub mod rng;
+pub mod scenario;
 pub mod sensor;
 pub mod sensor_config;
 pub mod sensor_data;

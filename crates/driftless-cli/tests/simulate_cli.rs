@@ -1,0 +1,145 @@
+//! `driftless simulate`: the self-contained example scenario end to end — files written,
+//! read back by `nav` in two formats — and scenario errors naming file and key.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_driftless"))
+}
+
+fn scenario(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/scenarios")
+        .join(name)
+}
+
+#[test]
+fn city_drive_scenario_writes_files_that_nav_reads() {
+    let dir = std::env::temp_dir().join(format!("driftless-sim-{}", std::process::id()));
+    let out = bin()
+        .args(["simulate", "--json", "--out"])
+        .arg(&dir)
+        .arg(scenario("city-drive.toml"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["seed"], 7);
+    let n = v["imu_samples"].as_u64().unwrap();
+    assert!(n > 20_000, "{n}");
+    for f in [
+        "imu.csv",
+        "imu.txt",
+        "truth.nav",
+        "gnss.txt",
+        "gnss.pos",
+        "kf-gins.yaml",
+        "sensor.toml",
+    ] {
+        assert!(dir.join(f).exists(), "{f} missing");
+    }
+    // Same seed, same bytes.
+    let again = dir.join("again");
+    let out = bin()
+        .args(["simulate", "--json", "--out"])
+        .arg(&again)
+        .arg(scenario("city-drive.toml"))
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    for f in ["imu.txt", "gnss.pos"] {
+        assert_eq!(
+            std::fs::read(dir.join(f)).unwrap(),
+            std::fs::read(again.join(f)).unwrap(),
+            "{f} differs between two runs with one seed"
+        );
+    }
+    // The KF-GINS job runs unchanged.
+    let out = bin()
+        .current_dir(&dir)
+        .args(["nav", "--kf-gins", "kf-gins.yaml", "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let k: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(k["epochs"].as_u64().unwrap(), n + 1);
+    assert!(k["gnss_accepted"].as_u64().unwrap() > 100);
+    // The rate CSV with the RTKLIB fixes (velocity included) through the generic path.
+    let out = bin()
+        .current_dir(&dir)
+        .args([
+            "nav",
+            "--imu",
+            "imu.csv",
+            "--imu-format",
+            "csv",
+            "--gnss",
+            "gnss.pos",
+            "--lever-arm",
+            "0.3,0,-1.2",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rms = r["horizontal_rms_m"].as_f64().unwrap();
+    eprintln!("simulated city drive through nav --imu-format csv: RMS {rms:.3} m");
+    assert!(rms < 0.2, "one-step prediction RMS {rms} m");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_scenario_names_file_and_key() {
+    let dir = std::env::temp_dir().join(format!("driftless-simbad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases = [
+        (
+            "[imu]\nrate_hz = 100.0\npreset = \"consumer\"\nspeed_km_h = 3\n[trajectory]\ntype = \"static\"\nlat_deg = 1.0\nduration_s = 10.0\n",
+            "speed_km_h",
+        ),
+        (
+            "[imu]\nrate_hz = 100.0\npreset = \"consumer\"\n[trajectory]\ntype = \"static\"\nlat_deg = 1.0\nduration_s = -10.0\n",
+            "duration_s",
+        ),
+        (
+            "[imu]\nrate_hz = 100.0\npreset = \"consumer\"\n[trajectory]\ntype = \"profile\"\n[trajectory.start]\nlat_deg = 1.0\nlon_deg = 1.0\nheight_m = 0.0\nheading_deg = 0.0\n[[trajectory.segment]]\ntype = \"turn\"\nangle_deg = 90.0\nradius_m = 0.0\n",
+            "radius_m",
+        ),
+        (
+            "[imu]\nrate_hz = 100.0\npreset = \"consumer\"\n[trajectory]\ntype = \"static\"\nlat_deg = 1.0\nduration_s = 10.0\n[temperature]\nkind = \"constant\"\nt_c = 120.0\n",
+            "120",
+        ),
+    ];
+    for (i, (text, want)) in cases.iter().enumerate() {
+        let p = dir.join(format!("bad{i}.toml"));
+        std::fs::write(&p, text).unwrap();
+        let out = bin()
+            .args(["simulate", "--out"])
+            .arg(dir.join("out"))
+            .arg(&p)
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "case {i} should fail");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(want) && err.contains(&format!("bad{i}.toml")),
+            "case {i}: {err}"
+        );
+        assert!(out.stdout.is_empty());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

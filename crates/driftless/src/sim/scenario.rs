@@ -1,0 +1,835 @@
+//! A simulation scenario (`driftless simulate SCENARIO.toml`): trajectory, sensor errors,
+//! temperature and GNSS in one TOML file, run reproducibly from a seed into a
+//! [`Simulation`] — IMU samples, GNSS fixes, the truth and (for the chamber) the segment
+//! manifest. Writing files is the caller's job (the CLI's `simulate`).
+//!
+//! ```toml
+//! seed = 7
+//! start_time_s = 356400.0   # GPS seconds of week of t = 0 (profile / static; optional)
+//! gps_week = 2300           # optional
+//!
+//! [imu]
+//! rate_hz = 200.0
+//! preset = "adis16465-like" # adi-like | adis16465-like | consumer | tactical | ideal
+//! # noise_model = "noise-model.toml"   # replaces the preset's noise terms
+//! # errors = "all"          # all | noise | deterministic | none
+//! # output = "increments"   # increments | rates
+//! # [imu.sensor] …          # a complete sensor configuration instead of a preset
+//!
+//! [trajectory]
+//! type = "recorded"         # recorded | profile | static | chamber
+//! file = "wuhan_gnss.txt"   # KF-GINS GNSS text or RTKLIB .pos (by extension)
+//!
+//! [temperature]             # optional (default constant 25 °C); not with a chamber
+//! kind = "warm_up"
+//! t0_c = 20.0
+//! t1_c = 45.0
+//! tau_s = 900.0
+//!
+//! [gnss]                    # optional; not with a chamber
+//! rate_hz = 1.0
+//! sigma_ned_m = [0.02, 0.02, 0.02]
+//! lever_arm_b_m = [0.0, 0.0, -1.0]
+//! outages = "9x60s every 300s from 300s"   # fixes removed from the output
+//! ```
+//!
+//! Trajectory kinds: `recorded` ([`super::recorded`]: `file`, optional
+//! `position_cutoff_hz`, `roll = "zero" | "coordinated_turn"`), `profile`
+//! ([`super::profile`]: `file`, or the profile's `[start]`/`[mounting]`/`[[segment]]`
+//! inline under `[trajectory]`), `static` (`lat_deg`, `lon_deg`, `height_m`, `roll_deg`,
+//! `pitch_deg`, `yaw_deg`, `duration_s`) and `chamber` ([`super::chamber::ChamberConfig`]
+//! keys; its sample rate is `imu.rate_hz`). Relative paths resolve against the
+//! scenario file's folder. Unknown keys anywhere are errors naming the key.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::chamber::ChamberConfig;
+use super::chamber_manifest::ChamberManifest;
+use super::gnss::{GnssSimConfig, simulate_gnss};
+use super::ideal_imu::{Trajectory, TrajectoryPoint};
+use super::presets::Preset;
+use super::recorded::{RecordedOptions, RecordedTrajectory, RollModel};
+use super::sensor::SensorModel;
+use super::sensor_config::SensorConfig;
+use super::sensor_data::{IdealImu, OutputKind, SensorOutput};
+use super::temperature::TemperatureProfile;
+use crate::io::nav::{GnssFixes, GnssReadOptions, NavSolution};
+use crate::nav::attitude::{Euler, Quat};
+use crate::nav::mechanization::NavState;
+use crate::nav::outage::{OutageSpec, TimeSpan};
+use driftless_model::units::DEG;
+
+/// Why a scenario could not be read or run.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// The scenario file could not be read or parsed (message names the key / line).
+    #[error("{path}: {message}")]
+    File {
+        /// Scenario file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value that parses but cannot be simulated.
+    #[error("{path}: {message}")]
+    Invalid {
+        /// Scenario file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A trajectory or GNSS setting refused by the simulator.
+    #[error("{path}: {source}")]
+    Sim {
+        /// Scenario file.
+        path: String,
+        /// The simulator's error.
+        source: super::noise::SimError,
+    },
+    /// A sensor or temperature setting refused by the sensor model.
+    #[error("{path}: {source}")]
+    Sensor {
+        /// Scenario file.
+        path: String,
+        /// The sensor model's error.
+        source: super::sensor_error::SensorSimError,
+    },
+    /// A referenced input file (trajectory, noise model) could not be read.
+    #[error(transparent)]
+    Input(#[from] crate::io::LogError),
+}
+
+/// Which error terms to simulate.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ErrorTerms {
+    /// Every configured term.
+    #[default]
+    All,
+    /// Only the stochastic terms (white, bias instability, random walks, quantization).
+    Noise,
+    /// Only the deterministic terms (biases, scale factors, misalignment, thermal).
+    Deterministic,
+    /// None: ideal output.
+    None,
+}
+
+/// `[imu]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImuSpec {
+    /// Sample rate, Hz.
+    pub rate_hz: f64,
+    /// Preset name ([`Preset`]) or `ideal`.
+    #[serde(default)]
+    pub preset: Option<String>,
+    /// A complete sensor configuration (instead of a preset).
+    #[serde(default)]
+    pub sensor: Option<SensorConfig>,
+    /// Noise-model file whose fitted terms replace the noise terms.
+    #[serde(default)]
+    pub noise_model: Option<PathBuf>,
+    /// Which error terms to simulate.
+    #[serde(default)]
+    pub errors: ErrorTerms,
+    /// Increments (default) or rates.
+    #[serde(default = "default_kind")]
+    pub output: OutputKind,
+}
+
+fn default_kind() -> OutputKind {
+    OutputKind::Increments
+}
+
+/// `[trajectory]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum TrajectorySpec {
+    /// Positions recorded at ≥ 1 Hz, smoothed.
+    Recorded {
+        /// KF-GINS GNSS text or RTKLIB `.pos`.
+        file: PathBuf,
+        /// Position smoother half-gain frequency, Hz.
+        #[serde(default)]
+        position_cutoff_hz: Option<f64>,
+        /// `zero` (default) or `coordinated_turn`.
+        #[serde(default)]
+        roll: Option<String>,
+    },
+    /// A land-vehicle motion profile, from a file or inline.
+    Profile {
+        /// Profile TOML file.
+        #[serde(default)]
+        file: Option<PathBuf>,
+        /// Inline `[start]`.
+        #[serde(default)]
+        start: Option<toml::Value>,
+        /// Inline `[mounting]`.
+        #[serde(default)]
+        mounting: Option<toml::Value>,
+        /// Inline `[[segment]]`s.
+        #[serde(default)]
+        segment: Option<Vec<toml::Value>>,
+    },
+    /// A static IMU.
+    Static {
+        /// Latitude, deg.
+        lat_deg: f64,
+        /// Longitude, deg.
+        #[serde(default)]
+        lon_deg: f64,
+        /// Height, m.
+        #[serde(default)]
+        height_m: f64,
+        /// Roll, deg.
+        #[serde(default)]
+        roll_deg: f64,
+        /// Pitch, deg.
+        #[serde(default)]
+        pitch_deg: f64,
+        /// Yaw, deg.
+        #[serde(default)]
+        yaw_deg: f64,
+        /// Length, s.
+        duration_s: f64,
+    },
+    /// The thermal-chamber protocol.
+    Chamber(ChamberConfig),
+}
+
+/// `[gnss]`: [`GnssSimConfig`] without the times (they follow the trajectory), with
+/// outages in the `--outages` grammar (relative to the first fix).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GnssSpec {
+    /// Fix rate, Hz.
+    pub rate_hz: f64,
+    /// White position σ north, east, down, m.
+    pub sigma_ned_m: [f64; 3],
+    /// Correlated position σ, m.
+    #[serde(default)]
+    pub correlated_sigma_ned_m: [f64; 3],
+    /// Its correlation time, s.
+    #[serde(default)]
+    pub correlated_tau_s: Option<f64>,
+    /// Velocity output σ, m/s.
+    #[serde(default)]
+    pub velocity_sigma_ned_m_s: Option<[f64; 3]>,
+    /// Lever arm IMU → antenna, body FRD, m.
+    #[serde(default)]
+    pub lever_arm_b_m: [f64; 3],
+    /// RTKLIB quality flag.
+    #[serde(default)]
+    pub quality: Option<u8>,
+    /// Outage windows (fixes removed), `--outages` grammar.
+    #[serde(default)]
+    pub outages: Option<String>,
+}
+
+/// `[output]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Folder (relative to the working directory).
+    #[serde(default = "default_dir")]
+    pub dir: PathBuf,
+    /// Truth (`truth.nav`) rate, Hz (default: the IMU rate).
+    #[serde(default)]
+    pub truth_rate_hz: Option<f64>,
+}
+
+fn default_dir() -> PathBuf {
+    PathBuf::from("sim-out")
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec {
+            dir: default_dir(),
+            truth_rate_hz: None,
+        }
+    }
+}
+
+/// A whole scenario file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Seed of every random draw.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// GPS seconds of week of t = 0 (profile and static trajectories).
+    #[serde(default)]
+    pub start_time_s: f64,
+    /// GPS week of the output.
+    #[serde(default)]
+    pub gps_week: Option<u16>,
+    /// The IMU.
+    pub imu: ImuSpec,
+    /// The motion.
+    pub trajectory: TrajectorySpec,
+    /// Sensor temperature (default constant 25 °C).
+    #[serde(default)]
+    pub temperature: Option<TemperatureProfile>,
+    /// GNSS.
+    #[serde(default)]
+    pub gnss: Option<GnssSpec>,
+    /// Output.
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// Folder relative paths resolve against (the scenario file's).
+    #[serde(skip)]
+    pub base_dir: PathBuf,
+    /// Name for messages.
+    #[serde(skip)]
+    pub name: String,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+
+/// The result of a scenario.
+#[derive(Clone, Debug)]
+pub struct Simulation {
+    /// IMU output (increments or rates), on output time.
+    pub imu: SensorOutput,
+    /// GNSS fixes, on output time.
+    pub gnss: Option<GnssFixes>,
+    /// Outage windows removed from `gnss`, output time, s.
+    pub gnss_outages_s: Vec<(f64, f64)>,
+    /// Truth at the truth rate, on output time.
+    pub truth: NavSolution,
+    /// Truth at the start of the first IMU interval (output time).
+    pub initial: NavState,
+    /// The resolved sensor configuration.
+    pub sensor: SensorConfig,
+    /// Chamber segments (chamber trajectories).
+    pub manifest: Option<ChamberManifest>,
+    /// The GNSS lever arm, body FRD, m.
+    pub lever_arm_b_m: [f64; 3],
+}
+
+impl Scenario {
+    /// Reads a scenario file.
+    pub fn from_file(path: impl AsRef<Path>) -> Result<Scenario, ScenarioError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::File {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let mut s = Scenario::from_toml_str(&text, &path.display().to_string())?;
+        s.base_dir = path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."));
+        Ok(s)
+    }
+
+    /// Parses scenario text; `name` is used in messages, relative paths resolve against
+    /// the working directory.
+    pub fn from_toml_str(text: &str, name: &str) -> Result<Scenario, ScenarioError> {
+        let mut s: Scenario = toml::from_str(text).map_err(|e| ScenarioError::File {
+            path: name.to_owned(),
+            message: e.to_string(),
+        })?;
+        s.name = name.to_owned();
+        s.base_dir = PathBuf::from(".");
+        Ok(s)
+    }
+
+    fn invalid(&self, message: impl Into<String>) -> ScenarioError {
+        ScenarioError::Invalid {
+            path: self.name.clone(),
+            message: message.into(),
+        }
+    }
+
+    fn resolve(&self, p: &Path) -> PathBuf {
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.base_dir.join(p)
+        }
+    }
+
+    /// The sensor configuration after preset, explicit config, noise model and
+    /// `errors`.
+    pub fn sensor_config(&self) -> Result<SensorConfig, ScenarioError> {
+        let mut cfg = match (&self.imu.preset, &self.imu.sensor) {
+            (Some(_), Some(_)) => {
+                return Err(self.invalid("imu: give `preset` or `[imu.sensor]`, not both"));
+            }
+            (Some(p), None) if p == "ideal" => SensorConfig::default(),
+            (Some(p), None) => p
+                .parse::<Preset>()
+                .map_err(|e| self.invalid(format!("imu.preset: {e}")))?
+                .config(),
+            (None, Some(c)) => c.clone(),
+            (None, None) => {
+                return Err(self.invalid(
+                    "imu: give `preset` (adi-like, adis16465-like, consumer, tactical, ideal) \
+                     or a `[imu.sensor]` table",
+                ));
+            }
+        };
+        if let Some(p) = &self.imu.noise_model {
+            let path = self.resolve(p);
+            let model = crate::allan::noise_model::NoiseModel::load(&path)
+                .map_err(|e| self.invalid(format!("imu.noise_model {}: {e}", path.display())))?;
+            cfg.apply_noise_model(&model)
+                .map_err(|e| self.invalid(format!("imu.noise_model: {e}")))?;
+        }
+        Ok(match self.imu.errors {
+            ErrorTerms::All => cfg,
+            ErrorTerms::Noise => cfg.noise_only(),
+            ErrorTerms::Deterministic => cfg.deterministic_only(),
+            ErrorTerms::None => SensorConfig {
+                valid_range_c: cfg.valid_range_c,
+                t_ref_c: cfg.t_ref_c,
+                ..SensorConfig::default()
+            },
+        })
+    }
+
+    /// Runs the scenario.
+    pub fn run(&self) -> Result<Simulation, ScenarioError> {
+        let rate = self.imu.rate_hz;
+        if !(rate.is_finite() && rate > 0.0 && rate <= 100_000.0) {
+            return Err(self.invalid(format!(
+                "imu.rate_hz must be a positive number of Hz up to 100 kHz, got {rate}"
+            )));
+        }
+        let dt = 1.0 / rate;
+        let sensor = self.sensor_config()?;
+        let model = SensorModel::new(sensor.clone()).map_err(|source| ScenarioError::Sensor {
+            path: self.name.clone(),
+            source,
+        })?;
+        let sim_err = |source| ScenarioError::Sim {
+            path: self.name.clone(),
+            source,
+        };
+        let sens_err = |source| ScenarioError::Sensor {
+            path: self.name.clone(),
+            source,
+        };
+        // The motion: a trajectory on its own clock, its span, and the output offset.
+        let traj: Box<dyn Trajectory + Sync>;
+        let (t0, t1, offset);
+        let mut manifest = None;
+        let mut temperature = self
+            .temperature
+            .clone()
+            .unwrap_or(TemperatureProfile::constant(25.0));
+        match &self.trajectory {
+            TrajectorySpec::Recorded {
+                file,
+                position_cutoff_hz,
+                roll,
+            } => {
+                let path = self.resolve(file);
+                let fixes =
+                    crate::nav::pipeline::read_gnss_file(&path, &GnssReadOptions::default())
+                        .map_err(|e| self.invalid(format!("trajectory.file: {e}")))?;
+                let mut opts = RecordedOptions::default();
+                if let Some(f) = position_cutoff_hz {
+                    opts.position_cutoff_hz = *f;
+                }
+                opts.roll = match roll.as_deref() {
+                    None | Some("zero") => RollModel::Zero,
+                    Some("coordinated_turn") => RollModel::CoordinatedTurn,
+                    Some(other) => {
+                        return Err(self.invalid(format!(
+                            "trajectory.roll = {other:?}: expected \"zero\" or \"coordinated_turn\""
+                        )));
+                    }
+                };
+                let r = RecordedTrajectory::from_fixes(&fixes, &opts).map_err(sim_err)?;
+                (t0, t1, offset) = (r.start_s(), r.end_s(), 0.0);
+                traj = Box::new(r);
+            }
+            TrajectorySpec::Profile {
+                file,
+                start,
+                mounting,
+                segment,
+            } => {
+                let profile = match (file, start) {
+                    (Some(f), None) => super::profile::MotionProfile::from_file(self.resolve(f))
+                        .map_err(sim_err)?,
+                    (None, Some(start)) => {
+                        let mut t = toml::Table::new();
+                        t.insert("start".into(), start.clone());
+                        if let Some(m) = mounting {
+                            t.insert("mounting".into(), m.clone());
+                        }
+                        t.insert(
+                            "segment".into(),
+                            toml::Value::Array(segment.clone().unwrap_or_default()),
+                        );
+                        let text = toml::to_string(&t)
+                            .map_err(|e| self.invalid(format!("trajectory: {e}")))?;
+                        super::profile::MotionProfile::from_toml_str(
+                            &text,
+                            &format!("{} [trajectory]", self.name),
+                        )
+                        .map_err(sim_err)?
+                    }
+                    _ => {
+                        return Err(self.invalid(
+                            "trajectory (profile): give `file` or an inline [trajectory.start] \
+                             with [[trajectory.segment]]s, not both",
+                        ));
+                    }
+                };
+                let lv = profile.build().map_err(sim_err)?;
+                (t0, t1, offset) = (0.0, lv.duration_s(), self.start_time_s);
+                traj = Box::new(lv);
+            }
+            TrajectorySpec::Static {
+                lat_deg,
+                lon_deg,
+                height_m,
+                roll_deg,
+                pitch_deg,
+                yaw_deg,
+                duration_s,
+            } => {
+                let vals = [
+                    *lat_deg, *lon_deg, *height_m, *roll_deg, *pitch_deg, *yaw_deg,
+                ];
+                if vals.iter().any(|v| !v.is_finite()) || lat_deg.abs() > 90.0 {
+                    return Err(self.invalid(
+                        "trajectory (static): position and attitude must be finite, |lat_deg| ≤ 90",
+                    ));
+                }
+                if !(duration_s.is_finite() && *duration_s > 0.0) {
+                    return Err(self.invalid(format!(
+                        "trajectory.duration_s must be > 0 s, got {duration_s}"
+                    )));
+                }
+                let c_bn = Euler {
+                    roll_rad: roll_deg * DEG,
+                    pitch_rad: pitch_deg * DEG,
+                    yaw_rad: yaw_deg * DEG,
+                }
+                .to_dcm();
+                let p = TrajectoryPoint {
+                    lat_rad: lat_deg * DEG,
+                    lon_rad: lon_deg * DEG,
+                    height_m: *height_m,
+                    vel_ned_m_s: [0.0; 3],
+                    acc_ned_m_s2: [0.0; 3],
+                    c_bn,
+                    omega_nb_b_rad_s: [0.0; 3],
+                };
+                (t0, t1, offset) = (0.0, *duration_s, self.start_time_s);
+                traj = Box::new(move |_t: f64| p);
+            }
+            TrajectorySpec::Chamber(c) => {
+                if self.temperature.is_some() || self.gnss.is_some() {
+                    return Err(self.invalid(
+                        "a chamber trajectory brings its own temperature profile and has no \
+                         GNSS: remove [temperature] and [gnss]",
+                    ));
+                }
+                let mut c = c.clone();
+                c.sample_rate_hz = rate;
+                let proto = c.build().map_err(sens_err)?;
+                temperature = proto.temperature.clone();
+                (t0, t1, offset) = (0.0, proto.manifest.duration_s, self.start_time_s);
+                manifest = Some(proto.manifest.clone());
+                traj = Box::new(proto.trajectory);
+            }
+        }
+        if !offset.is_finite() {
+            return Err(self.invalid("start_time_s must be finite"));
+        }
+        let n = ((t1 - t0) * rate + 1e-9).floor() as usize;
+        if n < 2 {
+            return Err(self.invalid(format!(
+                "the trajectory lasts {} s: fewer than two IMU samples at {rate} Hz",
+                t1 - t0
+            )));
+        }
+        let first = match self.imu.output {
+            OutputKind::Increments => t0 + dt,
+            OutputKind::Rates => t0,
+        };
+        let n = match self.imu.output {
+            OutputKind::Increments => n,
+            OutputKind::Rates => n + 1,
+        };
+        let curve = temperature.curve().map_err(sens_err)?;
+        let ideal = IdealImu::from_trajectory(&*traj, self.imu.output, first, dt, n);
+        let mut imu = model
+            .simulate(&ideal, &curve, self.seed)
+            .map_err(sens_err)?;
+        imu.first_time_s += offset;
+
+        // GNSS.
+        let (mut gnss, mut gnss_outages_s, mut lever) = (None, Vec::new(), [0.0; 3]);
+        if let Some(g) = &self.gnss {
+            let mut cfg = GnssSimConfig::new(g.rate_hz, t0, t1, 0.0);
+            cfg.sigma_ned_m = g.sigma_ned_m;
+            cfg.correlated_sigma_ned_m = g.correlated_sigma_ned_m;
+            if let Some(tau) = g.correlated_tau_s {
+                cfg.correlated_tau_s = tau;
+            }
+            cfg.velocity_sigma_ned_m_s = g.velocity_sigma_ned_m_s;
+            cfg.lever_arm_b_m = g.lever_arm_b_m;
+            if let Some(q) = g.quality {
+                cfg.quality = q;
+            }
+            cfg.time_offset_s = offset;
+            cfg.gps_week = self.gps_week;
+            // The first fix is at t0 (the start of the trajectory); 1 s margin at the end.
+            cfg.end_s = (t1 - 1e-6).max(t0);
+            if let Some(spec) = &g.outages {
+                let spec: OutageSpec = spec
+                    .parse()
+                    .map_err(|e| self.invalid(format!("gnss.outages: {e}")))?;
+                let windows = spec
+                    .resolve(TimeSpan {
+                        start_s: t0,
+                        end_s: cfg.end_s,
+                    })
+                    .map_err(|e| self.invalid(format!("gnss.outages: {e}")))?;
+                cfg.outages_s = windows.iter().map(|w| (w.start_s, w.end_s)).collect();
+                gnss_outages_s = cfg
+                    .outages_s
+                    .iter()
+                    .map(|&(a, b)| (a + offset, b + offset))
+                    .collect();
+            }
+            lever = g.lever_arm_b_m;
+            gnss = Some(simulate_gnss(&*traj, &cfg, self.seed ^ 0x9e37_79b9).map_err(sim_err)?);
+        }
+
+        // Truth.
+        let truth_rate = self.output.truth_rate_hz.unwrap_or(rate);
+        if !(truth_rate.is_finite() && truth_rate > 0.0) {
+            return Err(self.invalid(format!(
+                "output.truth_rate_hz must be > 0, got {truth_rate}"
+            )));
+        }
+        let nt = ((t1 - t0) * truth_rate + 1e-9).floor() as usize + 1;
+        let truth = truth_solution(&*traj, t0, 1.0 / truth_rate, nt, offset);
+        let mut initial = traj.point(t0).nav_state(t0 + offset);
+        initial.q_bn = initial.q_bn.normalized();
+        Ok(Simulation {
+            imu,
+            gnss,
+            gnss_outages_s,
+            truth,
+            initial,
+            sensor,
+            manifest,
+            lever_arm_b_m: lever,
+        })
+    }
+}
+
+/// Truth samples t0 + k·dt (k < n) as a navigation solution on output time.
+fn truth_solution<T: Trajectory + Sync + ?Sized>(
+    traj: &T,
+    t0: f64,
+    dt: f64,
+    n: usize,
+    offset: f64,
+) -> NavSolution {
+    use rayon::prelude::*;
+    let pts: Vec<TrajectoryPoint> = (0..n)
+        .into_par_iter()
+        .map(|k| traj.point(t0 + k as f64 * dt))
+        .collect();
+    let mut s = NavSolution::default();
+    for (k, p) in pts.iter().enumerate() {
+        let e = Euler::from_dcm(&p.c_bn);
+        s.time_s.push(t0 + k as f64 * dt + offset);
+        s.lat_rad.push(p.lat_rad);
+        s.lon_rad.push(p.lon_rad);
+        s.height_m.push(p.height_m);
+        s.vel_ned_m_s.push(p.vel_ned_m_s);
+        s.roll_pitch_yaw_rad
+            .push([e.roll_rad, e.pitch_rad, e.yaw_rad]);
+    }
+    s
+}
+
+impl Simulation {
+    /// The IMU output as a log of rates (increments divided by Δt: interval averages)
+    /// with the reported temperature, for CSV/DRIFTLOG output and `driftless nav
+    /// --imu-format csv`.
+    pub fn rates_log(&self, source: &str) -> crate::io::ImuLog {
+        let mut out = self.imu.clone();
+        if out.kind == OutputKind::Increments {
+            let inv = 1.0 / out.dt_s;
+            for v in out.gyro.iter_mut().chain(out.accel.iter_mut()) {
+                v.iter_mut().for_each(|x| *x *= inv);
+            }
+            out.kind = OutputKind::Rates;
+        }
+        out.to_imu_log(source)
+    }
+
+    /// The IMU output as KF-GINS increments.
+    pub fn increments(&self) -> crate::io::nav::ImuIncrements {
+        let inc = self.imu.to_increments();
+        crate::io::nav::ImuIncrements {
+            time_s: inc.iter().map(|i| i.time_s).collect(),
+            dtheta_rad: inc.iter().map(|i| i.dtheta_rad).collect(),
+            dvel_m_s: inc.iter().map(|i| i.dvel_m_s).collect(),
+        }
+    }
+}
+
+/// Attitude of a truth state as Euler angles (for configs), rad.
+pub fn euler_of(q: &Quat) -> Euler {
+    Euler::from_dcm(&q.to_dcm())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PROFILE: &str = r#"
+seed = 3
+start_time_s = 100000.0
+[imu]
+rate_hz = 100.0
+preset = "consumer"
+[trajectory]
+type = "profile"
+[trajectory.start]
+lat_deg = 30.5
+lon_deg = 114.3
+height_m = 20.0
+heading_deg = 10.0
+[[trajectory.segment]]
+type = "stop"
+duration_s = 5.0
+[[trajectory.segment]]
+type = "accelerate"
+to_speed_m_s = 10.0
+duration_s = 10.0
+[[trajectory.segment]]
+type = "turn"
+angle_deg = 90.0
+radius_m = 40.0
+[gnss]
+rate_hz = 1.0
+sigma_ned_m = [0.02, 0.02, 0.04]
+lever_arm_b_m = [0.5, 0.0, -1.0]
+outages = "8+5"
+"#;
+
+    #[test]
+    fn profile_scenario_runs_and_is_reproducible() {
+        let s = Scenario::from_toml_str(PROFILE, "p.toml").unwrap();
+        let a = s.run().unwrap();
+        let b = s.run().unwrap();
+        assert_eq!(a.imu, b.imu);
+        assert_eq!(a.gnss, b.gnss);
+        let dur = 15.0 + 40.0 * std::f64::consts::FRAC_PI_2 / 10.0;
+        assert_eq!(a.imu.len(), (dur * 100.0 + 1e-9).floor() as usize);
+        assert!((a.imu.time_s(0) - 100_000.01).abs() < 1e-9);
+        let g = a.gnss.as_ref().unwrap();
+        assert_eq!(g.time_s[0], 100_000.0);
+        assert!(
+            g.time_s
+                .iter()
+                .all(|&t| !(100_008.0..=100_013.0).contains(&t))
+        );
+        assert_eq!(a.gnss_outages_s, vec![(100_008.0, 100_013.0)]);
+        assert_eq!(
+            a.truth.time_s.len(),
+            (dur * 100.0 + 1e-9).floor() as usize + 1
+        );
+        assert_eq!(a.initial.time_s, 100_000.0);
+        let mut s2 = s.clone();
+        s2.seed = 4;
+        assert_ne!(s2.run().unwrap().imu, a.imu);
+    }
+
+    #[test]
+    fn bad_scenarios_are_named() {
+        let cases = [
+            (
+                PROFILE.replace("rate_hz = 100.0", "rate_hz = 100.0\nrate_khz = 1"),
+                "rate_khz",
+            ),
+            (
+                PROFILE.replace("\"consumer\"", "\"nasa-grade\""),
+                "nasa-grade",
+            ),
+            (
+                PROFILE.replace("to_speed_m_s = 10.0", "to_speed_m_s = -10.0"),
+                "to_speed_m_s",
+            ),
+            (
+                PROFILE.replace("radius_m = 40.0", "radius_m = 0.0"),
+                "radius_m",
+            ),
+            (
+                PROFILE.replace("type = \"profile\"", "type = \"orbit\""),
+                "orbit",
+            ),
+            (
+                PROFILE.replace("outages = \"8+5\"", "outages = \"20+500\""),
+                "gnss.outages",
+            ),
+            (
+                PROFILE.replace("rate_hz = 100.0", "rate_hz = \"100 Hz\""),
+                "rate_hz",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = Scenario::from_toml_str(&text, "p.toml")
+                .and_then(|s| s.run())
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(want) && e.contains("p.toml"), "{want}: {e}");
+        }
+        // A temperature outside the sensor model's valid range.
+        let hot = PROFILE.replace(
+            "[gnss]",
+            "[temperature]\nkind = \"constant\"\nt_c = 150.0\n[gnss]",
+        );
+        let e = Scenario::from_toml_str(&hot, "p.toml")
+            .unwrap()
+            .run()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("150"), "{e}");
+    }
+
+    #[test]
+    fn static_scenario_with_ideal_sensor_is_exact() {
+        let text = r#"
+[imu]
+rate_hz = 50.0
+preset = "ideal"
+output = "rates"
+[trajectory]
+type = "static"
+lat_deg = 45.0
+yaw_deg = 30.0
+duration_s = 2.0
+"#;
+        let sim = Scenario::from_toml_str(text, "s.toml")
+            .unwrap()
+            .run()
+            .unwrap();
+        assert_eq!(sim.imu.len(), 101);
+        let f = sim.imu.accel_at(50);
+        let g = crate::nav::earth::gravity_ned(45f64.to_radians(), 0.0)[2];
+        assert!((f[2] + g).abs() < 1e-12, "{f:?}");
+        let w = sim.imu.gyro_at(0);
+        let we = 7.292_115e-5;
+        assert!((driftless_model::linalg::norm(w) - we).abs() < 1e-9);
+    }
+}
