@@ -37,6 +37,9 @@ pub struct BenchArgs {
     /// Print results as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Run one group only: allan (parsing and Allan deviation), nav, sim.
+    #[arg(long, value_parser = ["allan", "nav", "sim"])]
+    pub only: Option<String>,
 }
 
 fn time_runs<T>(runs: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f64, f64)> {
@@ -52,6 +55,23 @@ fn time_runs<T>(runs: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f64, f
 }
 
 pub fn run(a: BenchArgs) -> Result<()> {
+    let want = |g: &str| a.only.as_deref().is_none_or(|o| o == g);
+    let mut results: Vec<(String, f64, f64, String)> = Vec::new();
+    if want("allan") {
+        allan_benches(&a, &mut results)?;
+    }
+    if want("nav") {
+        nav_benches(&a, &mut results)?;
+    }
+    if want("sim") {
+        sim_benches(&a, &mut results)?;
+    }
+    print_results(&a, &results)
+}
+
+type Results = Vec<(String, f64, f64, String)>;
+
+fn allan_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
     let rate = 100.0;
     let n = (a.hours * 3600.0 * rate).round() as usize;
     let cfg = StaticNoiseConfig {
@@ -85,7 +105,6 @@ pub fn run(a: BenchArgs) -> Result<()> {
         .collect();
     let time: Vec<f64> = (0..n).map(|i| i as f64 / rate).collect();
     let log = ImuLog::new("bench", Some(time), 1.0 / rate, channels);
-    let mut results: Vec<(String, f64, f64, String)> = Vec::new();
 
     if !a.no_io {
         std::fs::create_dir_all(&a.dir).with_context(|| format!("creating {}", a.dir.display()))?;
@@ -199,6 +218,10 @@ pub fn run(a: BenchArgs) -> Result<()> {
         ));
     }
 
+    Ok(())
+}
+
+fn nav_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
     // Strapdown mechanization: 1 h at 200 Hz of a constant-rate turn (ideal increments
     // generated first, outside the timing).
     {
@@ -349,6 +372,67 @@ pub fn run(a: BenchArgs) -> Result<()> {
         }
     }
 
+    Ok(())
+}
+
+/// Simulation speed (issue 4): an 18-h, 100 Hz six-axis static log through the full
+/// sensor model with every error term (ADIS16465-like preset), and a 1-h, 200 Hz land
+/// drive (TOML profile) with ideal increments, sensor errors and 1 Hz GNSS.
+fn sim_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
+    use driftless::sim::scenario::Scenario;
+    let static_18h = format!(
+        "seed = 5\n[imu]\nrate_hz = 100.0\npreset = \"adis16465-like\"\noutput = \"rates\"\n\
+         [trajectory]\ntype = \"static\"\nlat_deg = 30.5\nduration_s = {}\n",
+        a.hours * 3600.0
+    );
+    let sc = Scenario::from_toml_str(&static_18h, "bench static")?;
+    let (best, med) = time_runs(a.runs.min(3), || Ok(sc.run()?))?;
+    results.push((
+        format!(
+            "simulate {} h × 100 Hz static six-axis log, all error terms (adis16465-like)",
+            a.hours
+        ),
+        best,
+        med,
+        String::new(),
+    ));
+    // A 1-h drive: 14 laps of stop, accelerate, cruise, four right turns, brake.
+    let mut drive = String::from(
+        "seed = 3\n[imu]\nrate_hz = 200.0\npreset = \"adis16465-like\"\n[trajectory]\n\
+         type = \"profile\"\n[trajectory.start]\nlat_deg = 30.5\nlon_deg = 114.3\n\
+         height_m = 20.0\nheading_deg = 0.0\n",
+    );
+    for _ in 0..14 {
+        drive.push_str(
+            "[[trajectory.segment]]\ntype = \"stop\"\nduration_s = 20.0\n\
+             [[trajectory.segment]]\ntype = \"accelerate\"\nto_speed_m_s = 15.0\nduration_s = 10.0\n",
+        );
+        for _ in 0..4 {
+            drive.push_str(
+                "[[trajectory.segment]]\ntype = \"cruise\"\nduration_s = 50.0\n\
+                 [[trajectory.segment]]\ntype = \"turn\"\nangle_deg = 90.0\nradius_m = 40.0\n",
+            );
+        }
+        drive.push_str("[[trajectory.segment]]\ntype = \"brake\"\nduration_s = 8.0\n");
+    }
+    drive.push_str("[gnss]\nrate_hz = 1.0\nsigma_ned_m = [0.02, 0.02, 0.02]\n");
+    let sc = Scenario::from_toml_str(&drive, "bench drive")?;
+    let probe = sc.run()?;
+    let n = probe.imu.len();
+    let (best, med) = time_runs(a.runs.min(3), || Ok(sc.run()?))?;
+    results.push((
+        format!(
+            "simulate a {:.0}-min land drive at 200 Hz ({n} increments) with sensor errors and 1 Hz GNSS",
+            n as f64 * probe.imu.dt_s / 60.0
+        ),
+        best,
+        med,
+        format!("{:.2} s per hour", best * 3600.0 / (n as f64 * probe.imu.dt_s)),
+    ));
+    Ok(())
+}
+
+fn print_results(a: &BenchArgs, results: &Results) -> Result<()> {
     if a.json {
         let v: Vec<serde_json::Value> = results
             .iter()
@@ -357,7 +441,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         let mut t = crate::output::Table::new(["benchmark", "best [s]", "median [s]", "note"]);
-        for (w, b, m, note) in &results {
+        for (w, b, m, note) in results {
             t.row(vec![
                 w.clone(),
                 format!("{b:.3}"),

@@ -96,9 +96,6 @@ pub enum ScenarioError {
         /// The sensor model's error.
         source: super::sensor_error::SensorSimError,
     },
-    /// A referenced input file (trajectory, noise model) could not be read.
-    #[error(transparent)]
-    Input(#[from] crate::io::LogError),
 }
 
 /// Which error terms to simulate.
