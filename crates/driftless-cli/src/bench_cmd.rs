@@ -347,7 +347,7 @@ fn nav_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
             let cfg_path = dir.join("kf-gins.yaml");
             std::fs::write(&cfg_path, yaml)?;
             let (kbest, kmed) = time_runs(a.runs.min(3), || {
-                crate::nav_cmd::kf_gins_job(&cfg_path, "none", false).map(|_| ())
+                crate::nav_cmd::kf_gins_job(&cfg_path, "none", false, false).map(|_| ())
             })?;
             results.push((
                 format!(

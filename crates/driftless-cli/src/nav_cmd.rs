@@ -280,7 +280,12 @@ pub fn run(a: NavArgs) -> Result<()> {
 /// KF-GINS gives noise per axis; this filter takes one value per sensor, so the worst
 /// axis is used.
 fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
-    let job = kf_gins_job(path, &a.outages, true)?;
+    let job = kf_gins_job(
+        path,
+        &a.outages,
+        true,
+        a.csv.is_some() || a.geojson.is_some(),
+    )?;
     log_rejections(&job.run, 20);
     if a.csv.is_some() || a.geojson.is_some() {
         let (sol, _, _) = solution_records(&job.run);
@@ -291,7 +296,7 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
         println!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
-                "epochs": run.epochs.len(),
+                "epochs": run.first_epoch + run.epochs.len(),
                 "gnss_accepted": run.gnss_accepted,
                 "gnss_rejected": run.gnss_rejected,
                 "gnss_withheld": run.gnss_withheld,
@@ -302,7 +307,7 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
         println!(
             "{}: {} epochs from {:.3} s, GNSS {} accepted, {} rejected, {} withheld",
             path.display(),
-            run.epochs.len(),
+            run.first_epoch + run.epochs.len(),
             job.start_time_s,
             run.gnss_accepted,
             run.gnss_rejected,
@@ -325,7 +330,12 @@ pub struct KfGinsJob {
 
 /// Read a KF-GINS configuration and its files, run the forward filter, write KF-GINS's
 /// three output files.
-pub fn kf_gins_job(path: &std::path::Path, outages: &str, verbose: bool) -> Result<KfGinsJob> {
+pub fn kf_gins_job(
+    path: &std::path::Path,
+    outages: &str,
+    verbose: bool,
+    keep_records: bool,
+) -> Result<KfGinsJob> {
     use driftless::io::nav::{KfGinsConfig, read_kfgins_gnss_file};
     use driftless::nav::attitude::Euler;
     use driftless::nav::filter::run::{EpochRecord, InitialState, run_forward_observed};
@@ -433,23 +443,34 @@ pub fn kf_gins_job(path: &std::path::Path, outages: &str, verbose: bool) -> Resu
     let n_end = imu.epochs.partition_point(|e| e.time_s <= end);
     std::fs::create_dir_all(&k.output_dir)
         .with_context(|| format!("creating {}", k.output_dir.display()))?;
-    let mut writer = driftless::io::nav::KfGinsOutputWriter::create(&k.output_dir, 0)?;
-    // The filter runs on this thread; the output files are formatted and written on
-    // another from the blocks of epoch records the filter hands out.
+    // The filter runs on this thread; the output files are created (truncating an
+    // earlier run's), formatted and written on another from the blocks of epoch
+    // records the filter hands out. The records are not kept (no smoother here), except
+    // when --csv / --geojson need the whole solution.
+    let keep = keep_records;
+    let out_dir = k.output_dir.clone();
     let (run, files) = std::thread::scope(|scope| -> Result<_> {
         let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<EpochRecord>>(8);
         let formatter = scope.spawn(move || -> Result<[PathBuf; 3]> {
+            let mut writer = driftless::io::nav::KfGinsOutputWriter::create(&out_dir, 0)?;
             for block in rx {
                 let (sol, err, std) = epoch_solution_records(&block);
                 writer.append(&sol, &err, &std)?;
             }
             Ok(writer.finish()?)
         });
-        let run = run_forward_observed(&imu.epochs[..n_end], &gnss, init, &cfg, &mut |b| {
-            // A send fails only when the formatter has stopped on an error, which
-            // `join` reports below.
-            let _ = tx.send(b.to_vec());
-        });
+        let run = run_forward_observed(
+            &imu.epochs[..n_end],
+            &gnss,
+            init,
+            &cfg,
+            &mut |b| {
+                // A send fails only when the formatter has stopped on an error, which
+                // `join` reports below.
+                let _ = tx.send(b.to_vec());
+            },
+            keep,
+        );
         drop(tx);
         let files = formatter
             .join()

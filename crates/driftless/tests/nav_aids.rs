@@ -566,13 +566,40 @@ fn observer_sees_the_final_records() {
     let plain = run_forward(&d.imu, &d.gnss, initial(&d.traj), &cfg).expect("forward run");
     let mut seen = Vec::new();
     let mut blocks = 0;
-    let observed = run_forward_observed(&d.imu, &d.gnss, initial(&d.traj), &cfg, &mut |b| {
-        blocks += 1;
-        seen.extend_from_slice(b);
-    })
+    let observed = run_forward_observed(
+        &d.imu,
+        &d.gnss,
+        initial(&d.traj),
+        &cfg,
+        &mut |b| {
+            blocks += 1;
+            seen.extend_from_slice(b);
+        },
+        true,
+    )
     .expect("forward run");
     assert_eq!(observed, plain);
     assert!(plain.nhc_applied > 0 && plain.zupt_applied > 0 && plain.gnss_accepted > 0);
     assert_eq!(seen, plain.epochs);
     assert!(blocks > 1 && blocks <= plain.epochs.len() / OBSERVER_BLOCK + 1);
+    // Dropping the records once observed: the same records reach the observer, the
+    // update records point at the same epochs, the run keeps only its tail.
+    let mut seen2 = Vec::new();
+    let lean = run_forward_observed(
+        &d.imu,
+        &d.gnss,
+        initial(&d.traj),
+        &cfg,
+        &mut |b| seen2.extend_from_slice(b),
+        false,
+    )
+    .expect("forward run");
+    assert_eq!(seen2, plain.epochs);
+    assert_eq!(lean.updates, plain.updates);
+    assert_eq!(lean.first_epoch + lean.epochs.len(), plain.epochs.len());
+    assert!(lean.epochs.len() <= OBSERVER_BLOCK + 1);
+    assert!(
+        driftless::nav::filter::smoother::smooth(&lean, &initial(&d.traj), &cfg).is_err(),
+        "a run without its records cannot be smoothed"
+    );
 }

@@ -161,6 +161,11 @@ pub struct ForwardRun {
     pub aids_rejected: usize,
     /// Detected standstill intervals (start, end), s ([`super::aids`]).
     pub standstills: Vec<(f64, f64)>,
+    /// Index in the whole run of `epochs[0]`: 0, unless the records were handed to an
+    /// observer and dropped ([`run_forward_observed`] with `keep_epochs` false), when
+    /// `epochs` holds only the last record and `epoch_index` values count from the
+    /// start of the run.
+    pub first_epoch: usize,
     /// −1/T of the sensor states (to rebuild Φ).
     neg_inv_tau: [f64; 12],
 }
@@ -312,6 +317,7 @@ impl Ctx<'_> {
         let idx = self.run.epochs.len() - 1;
         let comp = self.run.epochs[idx].comp;
         self.run.epochs[idx] = record(f, comp);
+        let idx = idx + self.run.first_epoch;
         self.run.updates.push(UpdateRecord {
             epoch_index: idx,
             time_s: gn.time_s[g],
@@ -335,7 +341,7 @@ pub fn run_forward(
     init: InitialState,
     cfg: &FilterConfig,
 ) -> Result<ForwardRun, NavError> {
-    run_forward_observed(imu, gnss, init, cfg, &mut |_: &[EpochRecord]| {})
+    run_forward_observed(imu, gnss, init, cfg, &mut |_: &[EpochRecord]| {}, true)
 }
 
 /// Epoch records are handed to the observer of [`run_forward_observed`] in blocks of at
@@ -345,13 +351,16 @@ pub const OBSERVER_BLOCK: usize = 4096;
 /// [`run_forward`], handing the epoch records to `observer` while the filter runs: in
 /// order, each exactly once, in blocks of at least [`OBSERVER_BLOCK`] records once they
 /// are final (no later update at their epoch can change them), the last block at the
-/// end. Lets a caller write outputs on another thread while the filter runs.
+/// end. Lets a caller write outputs on another thread while the filter runs. With
+/// `keep_epochs` false the records are dropped once observed (memory stays small; the
+/// run cannot then be smoothed), see [`ForwardRun::first_epoch`].
 pub fn run_forward_observed(
     imu: &[ImuIncrement],
     gnss: &GnssFixes,
     init: InitialState,
     cfg: &FilterConfig,
     observer: &mut dyn FnMut(&[EpochRecord]),
+    keep_epochs: bool,
 ) -> Result<ForwardRun, NavError> {
     cfg.validate()?;
     check_gnss(gnss)?;
@@ -383,7 +392,12 @@ pub fn run_forward_observed(
         gnss_speed: None,
         last_position_accept_s: t0,
         run: ForwardRun {
-            epochs: Vec::with_capacity(imu.len() - start + gnss.len() + 1),
+            epochs: Vec::with_capacity(if keep_epochs {
+                imu.len() - start + gnss.len() + 1
+            } else {
+                2 * OBSERVER_BLOCK
+            }),
+            first_epoch: 0,
             updates: Vec::new(),
             gnss_withheld: 0,
             gnss_skipped: 0,
@@ -500,6 +514,11 @@ pub fn run_forward_observed(
         if settled - observed >= OBSERVER_BLOCK {
             observer(&ctx.run.epochs[observed..settled]);
             observed = settled;
+            if !keep_epochs {
+                ctx.run.epochs.drain(..settled);
+                ctx.run.first_epoch += settled;
+                observed = 0;
+            }
         }
     }
     observer(&ctx.run.epochs[observed..]);
@@ -641,6 +660,7 @@ impl AidState {
         let idx = run.epochs.len() - 1;
         let comp = run.epochs[idx].comp;
         run.epochs[idx] = record(f, comp);
+        let idx = idx + run.first_epoch;
         let p_post = pack(f.covariance());
         match run.updates.last_mut() {
             // A GNSS update at this very epoch: merge (prior stays the GNSS prior).

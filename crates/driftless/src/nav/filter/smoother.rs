@@ -85,7 +85,10 @@
 //! P λ and diag(P Λ P) (≈ 10 k multiply-adds): measured 4.4 µs per epoch on one core
 //! (1 h at 200 Hz: 3.2 s smoother + 1.0 s forward). A two-thread split of the run (the
 //! earlier half seeded by an adjoint-only pass over the later half) was tried and was
-//! slower on the 2-vCPU test machine, so the smoother runs on one thread.
+//! slower on the 2-vCPU test machine, and so was re-propagating the next chunk's
+//! covariances on a second thread while the backward sweep works on the current one
+//! (3.27 s vs 3.10 s: the sweep then reads every covariance from the other core's
+//! cache), so the smoother runs on one thread.
 
 use super::NavError;
 use super::model::{FilterConfig, Transition};
@@ -185,6 +188,13 @@ fn smooth_impl(
     visit: &mut dyn FnMut(usize, &Cov),
 ) -> Result<SmoothedRun, NavError> {
     cfg.validate()?;
+    if run.first_epoch != 0 {
+        return Err(NavError::Config(
+            "the forward run dropped its epoch records (run_forward_observed without \
+             keep_epochs): nothing to smooth"
+                .into(),
+        ));
+    }
     let n = run.epochs.len();
     if n == 0 {
         return Err(NavError::Config(
