@@ -232,7 +232,8 @@ pub struct OutputSpec {
     /// Folder (relative to the working directory).
     #[serde(default = "default_dir")]
     pub dir: PathBuf,
-    /// Truth (`truth.nav`) rate, Hz (default: the IMU rate).
+    /// Truth (`truth.nav`) rate, Hz (default: the IMU rate for moving trajectories,
+    /// 1 Hz for static and chamber ones).
     #[serde(default)]
     pub truth_rate_hz: Option<f64>,
 }
@@ -561,7 +562,14 @@ impl Scenario {
             OutputKind::Rates => n + 1,
         };
         let curve = temperature.curve().map_err(sens_err)?;
-        let ideal = IdealImu::from_trajectory(&*traj, self.imu.output, first, dt, n);
+        let ideal = match &self.trajectory {
+            // A static IMU's ideal output is one constant: no per-sample evaluation.
+            TrajectorySpec::Static { .. } => {
+                let (w, f) = traj.point(t0).imu_rates();
+                IdealImu::constant(self.imu.output, first, dt, n, w, f)
+            }
+            _ => IdealImu::from_trajectory(&*traj, self.imu.output, first, dt, n),
+        };
         let mut imu = model
             .simulate(&ideal, &curve, self.seed)
             .map_err(sens_err)?;
@@ -607,7 +615,14 @@ impl Scenario {
         }
 
         // Truth.
-        let truth_rate = self.output.truth_rate_hz.unwrap_or(rate);
+        let moving = matches!(
+            self.trajectory,
+            TrajectorySpec::Recorded { .. } | TrajectorySpec::Profile { .. }
+        );
+        let truth_rate =
+            self.output
+                .truth_rate_hz
+                .unwrap_or(if moving { rate } else { rate.min(1.0) });
         if !(truth_rate.is_finite() && truth_rate > 0.0) {
             return Err(self.invalid(format!(
                 "output.truth_rate_hz must be > 0, got {truth_rate}"
