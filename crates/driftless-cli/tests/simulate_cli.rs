@@ -8,6 +8,17 @@ fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_driftless"))
 }
 
+/// Runs `cmd`, which must succeed, and parses its `--json` output.
+fn run_json(cmd: &mut Command) -> serde_json::Value {
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 fn scenario(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples/scenarios")
@@ -17,18 +28,12 @@ fn scenario(name: &str) -> PathBuf {
 #[test]
 fn city_drive_scenario_writes_files_that_nav_reads() {
     let dir = std::env::temp_dir().join(format!("driftless-sim-{}", std::process::id()));
-    let out = bin()
-        .args(["simulate", "--json", "--out"])
-        .arg(&dir)
-        .arg(scenario("city-drive.toml"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let v = run_json(
+        bin()
+            .args(["simulate", "--json", "--out"])
+            .arg(&dir)
+            .arg(scenario("city-drive.toml")),
     );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["seed"], 7);
     let n = v["imu_samples"].as_u64().unwrap();
     assert!(n > 20_000, "{n}");
@@ -45,13 +50,12 @@ fn city_drive_scenario_writes_files_that_nav_reads() {
     }
     // Same seed, same bytes.
     let again = dir.join("again");
-    let out = bin()
-        .args(["simulate", "--json", "--out"])
-        .arg(&again)
-        .arg(scenario("city-drive.toml"))
-        .output()
-        .unwrap();
-    assert!(out.status.success());
+    run_json(
+        bin()
+            .args(["simulate", "--json", "--out"])
+            .arg(&again)
+            .arg(scenario("city-drive.toml")),
+    );
     for f in ["imu.txt", "gnss.pos"] {
         assert_eq!(
             std::fs::read(dir.join(f)).unwrap(),
@@ -60,42 +64,26 @@ fn city_drive_scenario_writes_files_that_nav_reads() {
         );
     }
     // The KF-GINS job runs unchanged.
-    let out = bin()
-        .current_dir(&dir)
-        .args(["nav", "--kf-gins", "kf-gins.yaml", "--json"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let k = run_json(
+        bin()
+            .current_dir(&dir)
+            .args(["nav", "--kf-gins", "kf-gins.yaml", "--json"]),
     );
-    let k: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(k["epochs"].as_u64().unwrap(), n + 1);
     assert!(k["gnss_accepted"].as_u64().unwrap() > 100);
     // The rate CSV with the RTKLIB fixes (velocity included) through the generic path.
-    let out = bin()
-        .current_dir(&dir)
-        .args([
-            "nav",
-            "--imu",
-            "imu.csv",
-            "--imu-format",
-            "csv",
-            "--gnss",
-            "gnss.pos",
-            "--lever-arm",
-            "0.3,0,-1.2",
-            "--json",
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = run_json(bin().current_dir(&dir).args([
+        "nav",
+        "--imu",
+        "imu.csv",
+        "--imu-format",
+        "csv",
+        "--gnss",
+        "gnss.pos",
+        "--lever-arm",
+        "0.3,0,-1.2",
+        "--json",
+    ]));
     let rms = r["horizontal_rms_m"].as_f64().unwrap();
     eprintln!("simulated city drive through nav --imu-format csv: RMS {rms:.3} m");
     assert!(rms < 0.2, "one-step prediction RMS {rms} m");
