@@ -2,11 +2,12 @@
 //!
 //! `no_std`, allocation-free: unit constants, the small 3-vector/3×3 algebra and the
 //! thermal polynomial ([`thermal::ThermalPoly`]) shared by the host library (simulation,
-//! calibration) and firmware; the compensation kernel (bias, scale factor, misalignment)
-//! lands with the calibration and thermal issues.
+//! calibration) and firmware, and the triad calibration `M·(raw − b)`
+//! ([`calib::TriadCalibration`]); thermal compensation lands with the thermal issue.
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod calib;
 pub mod linalg;
 pub mod thermal;
 pub mod units;

@@ -10,6 +10,7 @@
 #![deny(unsafe_code)]
 
 pub mod allan;
+pub mod calib;
 pub mod io;
 pub mod nav;
 pub mod report;
