@@ -133,7 +133,7 @@ fn first_degenerate(a: &[f64], n: usize, tol: f64) -> usize {
     let mut s: Vec<f64> = (0..n * n).map(|k| a[k] / (d[k / n] * d[k % n])).collect();
     for i in 0..n {
         let p = s[i * n + i];
-        if !(p > tol) {
+        if p.is_nan() || p <= tol {
             return i;
         }
         for r in (i + 1)..n {
