@@ -5,5 +5,7 @@
 //! calibrated = M · (raw − b).
 //!
 //! * [`lsq`]: dense linear least squares and Levenberg–Marquardt with covariances.
+//! * [`model_file`]: the calibration model file (TOML, with uncertainties).
 
 pub mod lsq;
+pub mod model_file;
