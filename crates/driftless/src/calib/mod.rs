@@ -5,5 +5,10 @@
 //! calibrated = M · (raw − b).
 //!
 //! * [`lsq`]: dense linear least squares and Levenberg–Marquardt with covariances.
+//! * [`static_detect`]: static-interval detection by moving variance (Tedaldi et al. 2014).
+//! * [`multi_position`]: multi-position accelerometer and gyro calibration without
+//!   fixtures (Tedaldi et al. 2014).
 
 pub mod lsq;
+pub mod multi_position;
+pub mod static_detect;
