@@ -6,6 +6,11 @@
 //!
 //! * [`lsq`]: dense linear least squares and Levenberg–Marquardt with covariances.
 //! * [`model_file`]: the calibration model file (TOML, with uncertainties).
+//! * [`static_detect`]: static-interval detection by moving variance (Tedaldi et al. 2014).
+//! * [`multi_position`]: multi-position accelerometer and gyro calibration without
+//!   fixtures (Tedaldi et al. 2014).
 
 pub mod lsq;
 pub mod model_file;
+pub mod multi_position;
+pub mod static_detect;
