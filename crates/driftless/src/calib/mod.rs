@@ -5,5 +5,8 @@
 //! calibrated = M · (raw − b).
 //!
 //! * [`lsq`]: dense linear least squares and Levenberg–Marquardt with covariances.
+//! * [`six_position`]: six-position accelerometer and rate-table gyro calibration with
+//!   covariances (Titterton & Weston §8; IEEE Std 1293).
 
 pub mod lsq;
+pub mod six_position;
