@@ -1,0 +1,824 @@
+//! Six-position (accelerometer) and rate-table (gyro) calibration with parameter
+//! covariances — IEEE Std 1293-2018 (Annex: the multi-position "tumble" test), Titterton
+//! & Weston, *Strapdown inertial navigation technology*, 2nd ed. 2004, §8.3 (six-position
+//! and rate-transfer tests), Groves, *Principles of GNSS, inertial, and multisensor
+//! integrated navigation systems*, 2nd ed. 2013, §4.4 (error models).
+//!
+//! # Model
+//!
+//! Per triad, the raw output (raw units; SI for simulated data) of a true input x is
+//!
+//! ```text
+//! raw = A·x + b (+ G·f for the gyro, optional)
+//! ```
+//!
+//! with A (3 × 3) scale factor and misalignment, b the bias and G the gyro g-sensitivity
+//! in raw units per m/s². The reported calibration is
+//! [`TriadCalibration`] `{ bias: b, matrix: M = A⁻¹ }`, i.e. calibrated = M·(raw − b).
+//! With the simulator's forward model (`sim::sensor`), A = (I + S)(I + M_mis).
+//!
+//! # Accelerometer (12 parameters, linear least squares)
+//!
+//! In a static position with body axis u (a signed unit axis) pointing up the specific
+//! force is f = g·u (g the local normal gravity, [`crate::nav::earth::normal_gravity_m_s2`],
+//! or an override). Every output axis i gives one linear equation per position,
+//!
+//! ```text
+//! raw_i(p) = Σ_j A_ij·f_j(p) + b_i,
+//! ```
+//!
+//! four unknowns per output axis, solved separately (the axes' noises are independent)
+//! from all positions (≥ 6, each axis up and down; repeats are welcome).
+//!
+//! # Gyro (12 parameters, or 21 with G)
+//!
+//! Per output axis i, one linear least squares over static positions and rate segments:
+//!
+//! * static position p (attitude C_bn(p)): the truth is Earth rate
+//!   ω^b = C_bnᵀ·ω_ie^n, ω_ie^n = Ω(cos L, 0, −sin L) (Groves eq. 2.123), so
+//!   raw_i = A_i·ω^b + b_i (+ G_i·f^b): the Earth rate is *modelled*, not averaged out.
+//!   It depends on the heading in each position: [`PositionMean::c_bn`] defaults to the
+//!   chamber protocol's attitude ([`SignedAxis::c_bn_up`]: a horizontal axis north);
+//!   set it for another fixture, or set the Earth rate to 0 to ignore it.
+//! * rate segment: a constant rate ω about body axis k over whole revolutions with the
+//!   table axis vertical and body axis u (normally +k) up. The horizontal Earth rate
+//!   averages to zero over whole revolutions and the vertical part is Ω sin L along u, so
+//!   the mean truth is ω^b = ω·e_k + Ω sin L·u and f^b = g·u. Opposite rates ±ω thus give
+//!   column k of A from (raw⁺ − raw⁻)/(2ω) (Titterton & Weston §8.3.3); the joint fit
+//!   uses the same information plus the bias.
+//!
+//! The g-sensitivity G (optional, [`SixPositionOptions::estimate_g_sensitivity`]) is
+//! separable from the bias only because each axis is seen both up and down: with f = ±g·e_k
+//! the pair gives b_i ± g·G_ik. With one direction of an axis missing, column k of G and b
+//! are confounded — that input is refused anyway ([`SixPositionError::MissingDirection`]).
+//!
+//! # Covariances
+//!
+//! Each observation is weighted by its own standard error: the sample standard deviation
+//! within the segment divided by √n (per-position sample std / √n, **not** the LS
+//! residuals). The parameter covariance is then (JᵀWJ)⁻¹ — honest for white noise within
+//! the dwells. Correlated noise (bias instability, rate random walk) makes it optimistic:
+//! the reported χ²/dof of the residuals ([`TriadEstimate::chi2_per_dof`]) should be ≈ 1,
+//! and the realised run-mean of such slow terms is indistinguishable from a bias offset.
+//! The covariance of M = A⁻¹ is propagated to first order: dM = −M·dA·M.
+
+use driftless_model::calib::{ImuCalibration, TriadCalibration};
+use driftless_model::linalg::{Mat3, Vec3};
+
+use super::lsq::{self, LsqError};
+use crate::nav::earth;
+use crate::sim::chamber::{BodyAxis, ChamberManifest, SegmentKind, SignedAxis};
+use crate::sim::sensor::{OutputKind, SensorOutput};
+
+/// Mean raw output of one static position.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PositionMean {
+    /// The body axis pointing up.
+    pub up: SignedAxis,
+    /// Attitude C_bn in the position (for the Earth rate); `up.c_bn_up()` by default.
+    pub c_bn: Mat3,
+    /// Mean raw accelerometer output.
+    pub accel_raw: Vec3,
+    /// Sample standard deviation of the raw accelerometer output.
+    pub accel_std_raw: Vec3,
+    /// Largest |raw accelerometer sample| (saturation check).
+    pub accel_peak_abs_raw: Vec3,
+    /// Mean raw gyro output.
+    pub gyro_raw: Vec3,
+    /// Sample standard deviation of the raw gyro output.
+    pub gyro_std_raw: Vec3,
+    /// Largest |raw gyro sample|.
+    pub gyro_peak_abs_raw: Vec3,
+    /// Number of samples averaged.
+    pub n: usize,
+}
+
+impl PositionMean {
+    /// A position in the chamber attitude of `up`, with the peaks taken as |mean|.
+    pub fn new(
+        up: SignedAxis,
+        accel_raw: Vec3,
+        accel_std_raw: Vec3,
+        gyro_raw: Vec3,
+        gyro_std_raw: Vec3,
+        n: usize,
+    ) -> PositionMean {
+        PositionMean {
+            up,
+            c_bn: up.c_bn_up(),
+            accel_raw,
+            accel_std_raw,
+            accel_peak_abs_raw: accel_raw.map(f64::abs),
+            gyro_raw,
+            gyro_std_raw,
+            gyro_peak_abs_raw: gyro_raw.map(f64::abs),
+            n,
+        }
+    }
+}
+
+/// Mean raw gyro output of one rate-table segment (whole revolutions at a constant rate).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RateMean {
+    /// Rotation axis (body).
+    pub axis: BodyAxis,
+    /// Commanded ω_nb about +axis, rad/s (signed).
+    pub rate_rad_s: f64,
+    /// The body axis pointing up during the rotation (the table axis is vertical).
+    pub up: SignedAxis,
+    /// Mean raw gyro output (= integrated raw angle / duration).
+    pub gyro_raw: Vec3,
+    /// Sample standard deviation of the raw gyro output.
+    pub gyro_std_raw: Vec3,
+    /// Largest |raw gyro sample|.
+    pub gyro_peak_abs_raw: Vec3,
+    /// Number of samples averaged.
+    pub n: usize,
+}
+
+/// Everything the calibration needs from a recording.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SixPositionInput {
+    /// Static positions (≥ 6, every axis up and down).
+    pub positions: Vec<PositionMean>,
+    /// Rate-table segments (≥ 1 per axis for the gyro).
+    pub rates: Vec<RateMean>,
+}
+
+/// Site constants and switches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SixPositionOptions {
+    /// Local gravity |f| in a static position, m/s².
+    pub gravity_m_s2: f64,
+    /// Site latitude, rad (for the Earth rate).
+    pub latitude_rad: f64,
+    /// Earth rotation rate, rad/s (0 ignores the Earth rate).
+    pub earth_rate_rad_s: f64,
+    /// Accelerometer output rail, raw units: a sample with |raw| ≥ this is saturated.
+    pub accel_rail_raw: Option<f64>,
+    /// Gyro output rail, raw units.
+    pub gyro_rail_raw: Option<f64>,
+    /// Also estimate the gyro g-sensitivity G (9 more parameters).
+    pub estimate_g_sensitivity: bool,
+}
+
+impl SixPositionOptions {
+    /// Normal gravity and Earth rate at latitude `lat_rad`, height `height_m`.
+    pub fn at_site(lat_rad: f64, height_m: f64) -> SixPositionOptions {
+        SixPositionOptions {
+            gravity_m_s2: earth::normal_gravity_m_s2(lat_rad, height_m),
+            latitude_rad: lat_rad,
+            earth_rate_rad_s: earth::OMEGA_IE,
+            accel_rail_raw: None,
+            gyro_rail_raw: None,
+            estimate_g_sensitivity: false,
+        }
+    }
+
+    /// The site constants of a chamber manifest (its exact gravity and Earth rate).
+    pub fn from_manifest(m: &ChamberManifest) -> SixPositionOptions {
+        SixPositionOptions {
+            gravity_m_s2: m.gravity_m_s2,
+            latitude_rad: m.latitude_deg.to_radians(),
+            earth_rate_rad_s: m.earth_rate_rad_s,
+            accel_rail_raw: None,
+            gyro_rail_raw: None,
+            estimate_g_sensitivity: false,
+        }
+    }
+}
+
+/// Why a calibration failed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SixPositionError {
+    /// Fewer than six static positions.
+    #[error("{n} static positions given; the six-position calibration needs at least 6")]
+    TooFewPositions {
+        /// Positions given.
+        n: usize,
+    },
+    /// No position with `up` pointing up.
+    #[error(
+        "no static position with {up} up: column {axis} of the scale/misalignment matrix and \
+         the biases (and the gyro g-sensitivity column) are not separable"
+    )]
+    MissingDirection {
+        /// The missing direction.
+        up: SignedAxis,
+        /// Body axis letter of the unobservable column.
+        axis: char,
+    },
+    /// No rate segment about an axis.
+    #[error(
+        "no rate-table segment about body {axis}: gyro scale/misalignment column {axis} is \
+         unobservable"
+    )]
+    MissingRate {
+        /// Axis letter.
+        axis: char,
+    },
+    /// A sample at the output rail.
+    #[error("{what}: {triad} axis {axis} reaches the rail ({value} ≥ {rail} raw units)")]
+    Saturated {
+        /// Which segment.
+        what: String,
+        /// "accelerometer" or "gyro".
+        triad: &'static str,
+        /// Axis letter.
+        axis: char,
+        /// |raw| seen.
+        value: f64,
+        /// The rail.
+        rail: f64,
+    },
+    /// A rate segment whose gyro output does not follow the command.
+    #[error(
+        "rate segment about {axis} at {commanded_rad_s} rad/s: the gyro saw \
+         {measured_rad_s} rad/s above its static bias — no (or reversed) rotation"
+    )]
+    NoRotation {
+        /// Axis letter.
+        axis: char,
+        /// Commanded rate.
+        commanded_rad_s: f64,
+        /// Mean gyro minus the static bias estimate.
+        measured_rad_s: f64,
+    },
+    /// NaN or infinity in the input.
+    #[error("non-finite value in {what}")]
+    NonFinite {
+        /// Where.
+        what: String,
+    },
+    /// An inconsistent input (bad option, attitude not matching the label, empty segment).
+    #[error("invalid input: {0}")]
+    Invalid(String),
+    /// The least squares failed.
+    #[error("{triad} axis {axis}: {source} ({param})")]
+    Lsq {
+        /// "accelerometer" or "gyro".
+        triad: &'static str,
+        /// Output axis letter.
+        axis: char,
+        /// Name of the parameter the solver flagged.
+        param: String,
+        /// Solver error.
+        source: LsqError,
+    },
+}
+
+/// One triad's estimate with its uncertainty.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriadEstimate {
+    /// M = A⁻¹ and b.
+    pub calibration: TriadCalibration,
+    /// A (raw = A·x + b).
+    pub forward_matrix: Mat3,
+    /// Covariance (12 × 12, row-major) of θ = (M₀₀, M₀₁, …, M₂₂, b₀, b₁, b₂).
+    pub covariance: Vec<f64>,
+    /// Σ (weighted residual)² over all equations.
+    pub chi2: f64,
+    /// Equations minus parameters.
+    pub dof: usize,
+}
+
+impl TriadEstimate {
+    /// 1σ of b, raw units.
+    pub fn bias_sigma(&self) -> Vec3 {
+        std::array::from_fn(|i| self.covariance[(9 + i) * 13].max(0.0).sqrt())
+    }
+
+    /// 1σ of each entry of M.
+    pub fn matrix_sigma(&self) -> [[f64; 3]; 3] {
+        std::array::from_fn(|a| {
+            std::array::from_fn(|b| self.covariance[(3 * a + b) * 13].max(0.0).sqrt())
+        })
+    }
+
+    /// χ²/dof of the weighted residuals (≈ 1 when the σ are honest; NaN without
+    /// redundancy).
+    pub fn chi2_per_dof(&self) -> f64 {
+        self.chi2 / self.dof as f64
+    }
+}
+
+/// Gyro g-sensitivity estimate (raw = A·ω + b + G·f).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GSensitivityEstimate {
+    /// G, raw gyro units per m/s².
+    pub matrix_raw_per_m_s2: Mat3,
+    /// 1σ of each entry.
+    pub sigma_raw_per_m_s2: [[f64; 3]; 3],
+}
+
+/// Result of [`calibrate`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SixPositionCalibration {
+    /// Accelerometer.
+    pub accel: TriadEstimate,
+    /// Gyro.
+    pub gyro: TriadEstimate,
+    /// Gyro g-sensitivity, when asked for.
+    pub gyro_g_sensitivity: Option<GSensitivityEstimate>,
+}
+
+impl SixPositionCalibration {
+    /// Both calibrations.
+    pub fn imu(&self) -> ImuCalibration {
+        ImuCalibration {
+            accel: self.accel.calibration,
+            gyro: self.gyro.calibration,
+        }
+    }
+}
+
+const AX: [char; 3] = ['x', 'y', 'z'];
+
+fn finite3(v: &Vec3, what: &str) -> Result<(), SixPositionError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(SixPositionError::NonFinite { what: what.into() })
+    }
+}
+
+fn check_rail(
+    peak: &Vec3,
+    rail: Option<f64>,
+    what: &str,
+    triad: &'static str,
+) -> Result<(), SixPositionError> {
+    let Some(rail) = rail else { return Ok(()) };
+    for (k, &p) in peak.iter().enumerate() {
+        if p >= rail {
+            return Err(SixPositionError::Saturated {
+                what: what.into(),
+                triad,
+                axis: AX[k],
+                value: p,
+                rail,
+            });
+        }
+    }
+    Ok(())
+}
+
+fn unit(s: SignedAxis) -> Vec3 {
+    let mut u = s.axis.unit();
+    u[s.axis.index()] = s.sign();
+    u
+}
+
+/// Validates the static positions (count, directions, finiteness, rails, attitude).
+fn check_positions(ps: &[PositionMean], opt: &SixPositionOptions) -> Result<(), SixPositionError> {
+    if ps.len() < 6 {
+        return Err(SixPositionError::TooFewPositions { n: ps.len() });
+    }
+    for up in SignedAxis::POSITIONS {
+        if !ps.iter().any(|p| p.up == up) {
+            return Err(SixPositionError::MissingDirection {
+                up,
+                axis: AX[up.axis.index()],
+            });
+        }
+    }
+    for p in ps {
+        let what = format!("position {} up", p.up);
+        for v in [
+            &p.accel_raw,
+            &p.accel_std_raw,
+            &p.accel_peak_abs_raw,
+            &p.gyro_raw,
+            &p.gyro_std_raw,
+            &p.gyro_peak_abs_raw,
+        ] {
+            finite3(v, &what)?;
+        }
+        if p.c_bn.0.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(SixPositionError::NonFinite { what });
+        }
+        if p.n == 0 {
+            return Err(SixPositionError::Invalid(format!("{what}: no samples")));
+        }
+        // The attitude must put `up` up: C_bnᵀ·(0, 0, −1) = u.
+        let c = &p.c_bn.0;
+        let u = unit(p.up);
+        let err = (0..3).map(|k| (-c[2][k] - u[k]).abs()).fold(0.0, f64::max);
+        if err > 1e-6 {
+            return Err(SixPositionError::Invalid(format!(
+                "{what}: the attitude C_bn does not put {} up",
+                p.up
+            )));
+        }
+        check_rail(
+            &p.accel_peak_abs_raw,
+            opt.accel_rail_raw,
+            &what,
+            "accelerometer",
+        )?;
+        check_rail(&p.gyro_peak_abs_raw, opt.gyro_rail_raw, &what, "gyro")?;
+    }
+    Ok(())
+}
+
+fn check_options(opt: &SixPositionOptions) -> Result<(), SixPositionError> {
+    let ok = opt.gravity_m_s2.is_finite()
+        && opt.gravity_m_s2 > 0.0
+        && opt.latitude_rad.is_finite()
+        && opt.earth_rate_rad_s.is_finite()
+        && opt.accel_rail_raw.is_none_or(|r| r > 0.0)
+        && opt.gyro_rail_raw.is_none_or(|r| r > 0.0);
+    if ok {
+        Ok(())
+    } else {
+        Err(SixPositionError::Invalid(format!(
+            "options {opt:?} (gravity > 0, finite latitude and Earth rate, rails > 0)"
+        )))
+    }
+}
+
+/// One equation: regressor row, observation, its standard error.
+struct Row {
+    x: Vec<f64>,
+    y: f64,
+    sigma: f64,
+}
+
+/// Weighted LS of one output axis: (params, covariance (JᵀWJ)⁻¹, χ²).
+fn weighted_fit(
+    rows: &[Row],
+    n: usize,
+    triad: &'static str,
+    axis: usize,
+    names: &[String],
+) -> Result<(Vec<f64>, Vec<f64>, f64), SixPositionError> {
+    let m = rows.len();
+    // Floor the standard errors at 1e-3 of the largest (noise-free data: all ≈ 0) so
+    // that rounding-level σ do not dominate the conditioning; all zero → unit weights.
+    let smax = rows.iter().map(|r| r.sigma).fold(0.0, f64::max);
+    let sig = |s: f64| if smax > 0.0 { s.max(1e-3 * smax) } else { 1.0 };
+    let mut j = Vec::with_capacity(m * n);
+    let mut y = Vec::with_capacity(m);
+    for r in rows {
+        let s = sig(r.sigma);
+        j.extend(r.x.iter().map(|v| v / s));
+        y.push(r.y / s);
+    }
+    let lsq_err = |source: LsqError| {
+        let param = match &source {
+            LsqError::Unobservable { param } => names.get(*param).cloned().unwrap_or_default(),
+            _ => String::new(),
+        };
+        SixPositionError::Lsq {
+            triad,
+            axis: AX[axis],
+            param,
+            source,
+        }
+    };
+    let fit = lsq::linear(&j, &y, m, n).map_err(lsq_err)?;
+    let (jtj, _) = lsq::normal_equations(&j, &y, m, n);
+    let l = lsq::cholesky(&jtj, n).ok_or_else(|| lsq_err(LsqError::Unobservable { param: 0 }))?;
+    let cov = lsq::cholesky_inverse(&l, n);
+    let chi2 = (0..m)
+        .map(|r| {
+            let pred: f64 = (0..n).map(|c| j[r * n + c] * fit.params[c]).sum();
+            (y[r] - pred).powi(2)
+        })
+        .sum();
+    Ok((fit.params, cov, chi2))
+}
+
+/// Assembles A, b and their 12 × 12 covariance (θ_A = vec(A) row-major, then b) from
+/// per-axis fits whose first four parameters are (A_i0, A_i1, A_i2, b_i); returns the
+/// [`TriadEstimate`] of M = A⁻¹.
+fn triad_estimate(
+    fits: &[(Vec<f64>, Vec<f64>, f64); 3],
+    n_params: usize,
+    n_eq: usize,
+    triad: &'static str,
+) -> Result<TriadEstimate, SixPositionError> {
+    let mut a = Mat3::ZERO;
+    let mut bias = [0.0; 3];
+    let mut cov_a = vec![0.0; 144];
+    let idx = |i: usize, p: usize| if p < 3 { 3 * i + p } else { 9 + i };
+    for (i, (p, c, _)) in fits.iter().enumerate() {
+        a.0[i] = [p[0], p[1], p[2]];
+        bias[i] = p[3];
+        for r in 0..4 {
+            for s in 0..4 {
+                cov_a[idx(i, r) * 12 + idx(i, s)] = c[r * n_params + s];
+            }
+        }
+    }
+    let m = a.inverse().ok_or_else(|| {
+        SixPositionError::Invalid(format!("{triad}: the estimated A is singular"))
+    })?;
+    // Jacobian of θ_M = (vec M, b) w.r.t. θ_A: ∂M_ab/∂A_ij = −M_ai·M_jb; b → b.
+    let mut jac = vec![0.0; 144];
+    for a_ in 0..3 {
+        for b_ in 0..3 {
+            for i in 0..3 {
+                for j in 0..3 {
+                    jac[(3 * a_ + b_) * 12 + 3 * i + j] = -m.0[a_][i] * m.0[j][b_];
+                }
+            }
+        }
+    }
+    for i in 0..3 {
+        jac[(9 + i) * 12 + 9 + i] = 1.0;
+    }
+    let mut tmp = vec![0.0; 144];
+    for r in 0..12 {
+        for c in 0..12 {
+            tmp[r * 12 + c] = (0..12).map(|k| jac[r * 12 + k] * cov_a[k * 12 + c]).sum();
+        }
+    }
+    let mut cov = vec![0.0; 144];
+    for r in 0..12 {
+        for c in 0..12 {
+            cov[r * 12 + c] = (0..12).map(|k| tmp[r * 12 + k] * jac[c * 12 + k]).sum();
+        }
+    }
+    Ok(TriadEstimate {
+        calibration: TriadCalibration { bias, matrix: m },
+        forward_matrix: a,
+        covariance: cov,
+        chi2: fits.iter().map(|f| f.2).sum(),
+        dof: 3 * n_eq.saturating_sub(n_params),
+    })
+}
+
+fn param_names(triad: &str, i: usize, with_g: bool) -> Vec<String> {
+    let mut v: Vec<String> = (0..3)
+        .map(|j| format!("{triad} A_{}{}", AX[i], AX[j]))
+        .collect();
+    v.push(format!("{triad} bias b_{}", AX[i]));
+    if with_g {
+        v.extend((0..3).map(|j| format!("gyro g-sensitivity G_{}{}", AX[i], AX[j])));
+    }
+    v
+}
+
+fn std_error(std: f64, n: usize) -> f64 {
+    std / (n as f64).sqrt()
+}
+
+/// Accelerometer: 12-parameter LS over the static positions (module docs).
+pub fn calibrate_accel(
+    positions: &[PositionMean],
+    opt: &SixPositionOptions,
+) -> Result<TriadEstimate, SixPositionError> {
+    check_options(opt)?;
+    check_positions(positions, opt)?;
+    let g = opt.gravity_m_s2;
+    let mut fits = Vec::with_capacity(3);
+    for i in 0..3 {
+        let rows: Vec<Row> = positions
+            .iter()
+            .map(|p| {
+                let f = unit(p.up).map(|u| g * u);
+                Row {
+                    x: vec![f[0], f[1], f[2], 1.0],
+                    y: p.accel_raw[i],
+                    sigma: std_error(p.accel_std_raw[i], p.n),
+                }
+            })
+            .collect();
+        fits.push(weighted_fit(
+            &rows,
+            4,
+            "accelerometer",
+            i,
+            &param_names("accelerometer", i, false),
+        )?);
+    }
+    let fits: [_; 3] = fits
+        .try_into()
+        .map_err(|_| SixPositionError::Invalid("internal: three axes".into()))?;
+    triad_estimate(&fits, 4, positions.len(), "accelerometer")
+}
+
+/// Gyro: bias, scale/misalignment (and optionally G) from the static positions (Earth
+/// rate modelled) and the rate-table segments (module docs).
+pub fn calibrate_gyro(
+    positions: &[PositionMean],
+    rates: &[RateMean],
+    opt: &SixPositionOptions,
+) -> Result<(TriadEstimate, Option<GSensitivityEstimate>), SixPositionError> {
+    check_options(opt)?;
+    check_positions(positions, opt)?;
+    for axis in BodyAxis::ALL {
+        if !rates.iter().any(|r| r.axis == axis) {
+            return Err(SixPositionError::MissingRate {
+                axis: AX[axis.index()],
+            });
+        }
+    }
+    // Static bias guess for the rotation check: the mean over all positions.
+    let np = positions.len() as f64;
+    let b0: Vec3 =
+        std::array::from_fn(|k| positions.iter().map(|p| p.gyro_raw[k]).sum::<f64>() / np);
+    for r in rates {
+        let k = r.axis.index();
+        let what = format!("rate segment about {} at {} rad/s", AX[k], r.rate_rad_s);
+        finite3(&r.gyro_raw, &what)?;
+        finite3(&r.gyro_std_raw, &what)?;
+        finite3(&r.gyro_peak_abs_raw, &what)?;
+        if !r.rate_rad_s.is_finite() || r.rate_rad_s == 0.0 || r.n == 0 {
+            return Err(SixPositionError::Invalid(format!(
+                "{what}: needs a finite non-zero rate and samples"
+            )));
+        }
+        if r.up.axis != r.axis {
+            return Err(SixPositionError::Invalid(format!(
+                "{what}: the rotation axis must be vertical (up = {})",
+                r.up
+            )));
+        }
+        check_rail(&r.gyro_peak_abs_raw, opt.gyro_rail_raw, &what, "gyro")?;
+        let measured = r.gyro_raw[k] - b0[k];
+        let ratio = measured / r.rate_rad_s;
+        if ratio.is_nan() || ratio <= 0.5 {
+            return Err(SixPositionError::NoRotation {
+                axis: AX[k],
+                commanded_rad_s: r.rate_rad_s,
+                measured_rad_s: measured,
+            });
+        }
+    }
+    let g = opt.gravity_m_s2;
+    let w_ie = [
+        opt.earth_rate_rad_s * opt.latitude_rad.cos(),
+        0.0,
+        -opt.earth_rate_rad_s * opt.latitude_rad.sin(),
+    ];
+    let w_up = opt.earth_rate_rad_s * opt.latitude_rad.sin();
+    let with_g = opt.estimate_g_sensitivity;
+    let n = if with_g { 7 } else { 4 };
+    let mut fits = Vec::with_capacity(3);
+    for i in 0..3 {
+        let mut rows = Vec::with_capacity(positions.len() + rates.len());
+        for p in positions {
+            let w = p.c_bn.t().mul_vec(w_ie);
+            let f = unit(p.up).map(|u| g * u);
+            let mut x = vec![w[0], w[1], w[2], 1.0];
+            if with_g {
+                x.extend_from_slice(&f);
+            }
+            rows.push(Row {
+                x,
+                y: p.gyro_raw[i],
+                sigma: std_error(p.gyro_std_raw[i], p.n),
+            });
+        }
+        for r in rates {
+            let u = unit(r.up);
+            let mut w = u.map(|c| w_up * c);
+            w[r.axis.index()] += r.rate_rad_s;
+            let mut x = vec![w[0], w[1], w[2], 1.0];
+            if with_g {
+                x.extend(u.map(|c| g * c));
+            }
+            rows.push(Row {
+                x,
+                y: r.gyro_raw[i],
+                sigma: std_error(r.gyro_std_raw[i], r.n),
+            });
+        }
+        fits.push(weighted_fit(
+            &rows,
+            n,
+            "gyro",
+            i,
+            &param_names("gyro", i, with_g),
+        )?);
+    }
+    let fits: [_; 3] = fits
+        .try_into()
+        .map_err(|_| SixPositionError::Invalid("internal: three axes".into()))?;
+    let gs = with_g.then(|| GSensitivityEstimate {
+        matrix_raw_per_m_s2: Mat3(std::array::from_fn(|i| {
+            std::array::from_fn(|j| fits[i].0[4 + j])
+        })),
+        sigma_raw_per_m_s2: std::array::from_fn(|i| {
+            std::array::from_fn(|j| fits[i].1[(4 + j) * n + 4 + j].max(0.0).sqrt())
+        }),
+    });
+    let est = triad_estimate(&fits, n, positions.len() + rates.len(), "gyro")?;
+    Ok((est, gs))
+}
+
+/// Both triads (module docs).
+pub fn calibrate(
+    input: &SixPositionInput,
+    opt: &SixPositionOptions,
+) -> Result<SixPositionCalibration, SixPositionError> {
+    let accel = calibrate_accel(&input.positions, opt)?;
+    let (gyro, gyro_g_sensitivity) = calibrate_gyro(&input.positions, &input.rates, opt)?;
+    Ok(SixPositionCalibration {
+        accel,
+        gyro,
+        gyro_g_sensitivity,
+    })
+}
+
+/// Mean, sample standard deviation and peak |x| of a segment of one channel, in rate
+/// units (increments are divided by Δt).
+fn channel_stats(col: &[f64], scale: f64) -> (f64, f64, f64) {
+    let n = col.len() as f64;
+    let mean = col.iter().sum::<f64>() / n;
+    let var = if col.len() > 1 {
+        col.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)
+    } else {
+        0.0
+    };
+    let peak = col.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    (mean * scale, var.sqrt() * scale.abs(), peak * scale.abs())
+}
+
+type Stats3 = (Vec3, Vec3, Vec3);
+
+fn triad_stats(cols: &[Vec<f64>; 3], range: std::ops::Range<usize>, scale: f64) -> Stats3 {
+    let s: [(f64, f64, f64); 3] =
+        std::array::from_fn(|k| channel_stats(&cols[k][range.clone()], scale));
+    (s.map(|v| v.0), s.map(|v| v.1), s.map(|v| v.2))
+}
+
+impl SixPositionInput {
+    /// The position and rate segments at set temperature `set_temperature_c` of a chamber
+    /// manifest, averaged from a simulated (or recorded, same layout) output: rates are
+    /// used as they are, increments divided by Δt. Samples per segment:
+    /// [`crate::sim::chamber::Segment::sample_range`].
+    pub fn from_chamber(
+        manifest: &ChamberManifest,
+        out: &SensorOutput,
+        set_temperature_c: f64,
+    ) -> Result<SixPositionInput, SixPositionError> {
+        let fs = manifest.sample_rate_hz;
+        if !(fs > 0.0 && out.dt_s > 0.0) || ((1.0 / fs) - out.dt_s).abs() > 1e-9 * out.dt_s {
+            return Err(SixPositionError::Invalid(format!(
+                "manifest rate {fs} Hz does not match the output's Δt = {} s",
+                out.dt_s
+            )));
+        }
+        let scale = match out.kind {
+            OutputKind::Rates => 1.0,
+            OutputKind::Increments => 1.0 / out.dt_s,
+        };
+        let mut input = SixPositionInput::default();
+        for seg in manifest
+            .segments
+            .iter()
+            .filter(|s| s.set_temperature_c == set_temperature_c)
+        {
+            let range = seg.sample_range(fs);
+            if range.is_empty() || range.end > out.len() {
+                if matches!(
+                    seg.kind,
+                    SegmentKind::Position { .. } | SegmentKind::Rate { .. }
+                ) {
+                    return Err(SixPositionError::Invalid(format!(
+                        "segment {:.3}–{:.3} s: samples {range:?} not inside the {} recorded",
+                        seg.start_s,
+                        seg.end_s,
+                        out.len()
+                    )));
+                }
+                continue;
+            }
+            let n = range.len();
+            match seg.kind {
+                SegmentKind::Position { up } => {
+                    let (am, asd, apk) = triad_stats(&out.accel, range.clone(), scale);
+                    let (gm, gsd, gpk) = triad_stats(&out.gyro, range, scale);
+                    input.positions.push(PositionMean {
+                        up,
+                        c_bn: up.c_bn_up(),
+                        accel_raw: am,
+                        accel_std_raw: asd,
+                        accel_peak_abs_raw: apk,
+                        gyro_raw: gm,
+                        gyro_std_raw: gsd,
+                        gyro_peak_abs_raw: gpk,
+                        n,
+                    });
+                }
+                SegmentKind::Rate { axis, rate_rad_s } => {
+                    let (gm, gsd, gpk) = triad_stats(&out.gyro, range, scale);
+                    input.rates.push(RateMean {
+                        axis,
+                        rate_rad_s,
+                        up: SignedAxis::new(axis, true),
+                        gyro_raw: gm,
+                        gyro_std_raw: gsd,
+                        gyro_peak_abs_raw: gpk,
+                        n,
+                    });
+                }
+                SegmentKind::Soak | SegmentKind::Move => {}
+            }
+        }
+        Ok(input)
+    }
+}
