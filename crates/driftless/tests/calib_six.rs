@@ -205,7 +205,9 @@ fn noise_free_recovery_is_exact() {
 /// instability and rate random walk off — see the module docs of `six_position`: their
 /// realised run-mean is indistinguishable from the bias and not in the white-noise σ):
 /// the fraction of the 24 parameters (M and b of both triads) within 1.96σ of the truth is
-/// 95 % ± 5 %, within 3σ ≥ 99 %.
+/// 95 % ± 5 %, within 3σ ≥ 99 %. With bias instability and rate random walk on, the
+/// χ²-inflated σ covers 83.6 % (consumer) and 88.8 % (adis16465-like) at 1.96σ: printed,
+/// not yet at the bar.
 #[test]
 fn covariance_coverage_over_seeds() {
     let t0 = Instant::now();
