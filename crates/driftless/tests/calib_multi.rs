@@ -132,6 +132,7 @@ fn rot(phi: Vec3) -> Mat3 {
     let k = Mat3::skew(phi.map(|v| v / t));
     let k2 = k.mul_mat(&k);
     let mut r = [[0.0; 3]; 3];
+    #[allow(clippy::needless_range_loop)]
     for i in 0..3 {
         for j in 0..3 {
             r[i][j] =
@@ -352,4 +353,116 @@ fn simulated_poses_coverage() {
     );
     assert!((in196 - 0.95).abs() <= 0.05, "{in196}");
     assert!(in3 >= 0.99, "{in3}");
+}
+
+// ---------------------------------------------------------------------------------------
+// Bad input
+// ---------------------------------------------------------------------------------------
+
+fn sim_log(moves: &[Vec3], c0: Mat3) -> (Vec<f64>, Vec<Vec3>, Vec<Vec3>) {
+    let ideal = poses(c0, moves);
+    let (_, out) = simulate(Preset::Adis16465Like, &ideal, 5);
+    columns(&out)
+}
+
+#[test]
+fn too_few_intervals() {
+    let mut rng = Gen(7);
+    let (t, a, w) = sim_log(&random_moves(&mut rng, 5), Mat3::IDENTITY);
+    let e = calibrate_multi_position(&t, &a, &w, &sim_options()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            CalibError::TooFewIntervals {
+                found: 6,
+                needed: 10
+            }
+        ),
+        "{e}"
+    );
+    println!("{e}");
+}
+
+#[test]
+fn all_poses_z_up_leave_x_scale_unobservable() {
+    // body z up (specific force +g on z), then small tilts (≤ 10°) about horizontal axes
+    let mut rng = Gen(11);
+    let moves: Vec<Vec3> = (0..20)
+        .map(|i| {
+            let a = (8.0 * (rng.next() - 0.5)).to_radians() * if i % 2 == 0 { 1.0 } else { -1.0 };
+            [a, 0.5 * a, 0.0]
+        })
+        .collect();
+    let c0 = rot([std::f64::consts::PI, 0.0, 0.0]);
+    let (t, a, w) = sim_log(&moves, c0);
+    let e = calibrate_multi_position(&t, &a, &w, &sim_options()).unwrap_err();
+    match &e {
+        CalibError::Unobservable {
+            sensor, parameter, ..
+        } => {
+            assert_eq!((*sensor, parameter.as_str()), ("accelerometer", "x scale"));
+        }
+        other => panic!("{other}"),
+    }
+    println!("{e}");
+}
+
+#[test]
+fn saturated_axis_is_named() {
+    let mut rng = Gen(3);
+    let (t, mut a, w) = sim_log(&random_moves(&mut rng, 30), Mat3::IDENTITY);
+    // an x accelerometer with a rail at +0.8 g: poses with x up clip
+    let rail = 0.8 * G;
+    for v in &mut a {
+        v[0] = v[0].min(rail);
+    }
+    let opts = MultiPositionOptions {
+        accel_range_raw: Some([-2.0 * G, rail]),
+        ..sim_options()
+    };
+    let e = calibrate_multi_position(&t, &a, &w, &opts).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            CalibError::Saturated {
+                sensor: "accelerometer",
+                axis: 'x',
+                ..
+            }
+        ),
+        "{e}"
+    );
+    println!("{e}");
+}
+
+#[test]
+fn all_static_log_leaves_gyro_scale_unobservable() {
+    // a whole static log is one interval
+    let ideal = poses(Mat3::IDENTITY, &[[0.0; 3]]);
+    let (_, out) = simulate(Preset::Adis16465Like, &ideal, 9);
+    let (t, a, w) = columns(&out);
+    let e = calibrate_multi_position(&t, &a, &w, &sim_options()).unwrap_err();
+    assert!(
+        matches!(e, CalibError::TooFewIntervals { found: 1, .. }),
+        "{e}"
+    );
+    // good poses for the accelerometer, but a gyro log without rotation
+    let mut rng = Gen(4);
+    let (t, a, w_moving) = sim_log(&random_moves(&mut rng, 30), Mat3::IDENTITY);
+    let opts = sim_options();
+    let cal = calibrate_multi_position(&t, &a, &w_moving, &opts).expect("good log");
+    let still: Vec<Vec3> = (0..t.len()).map(|k| w[k % w.len()]).collect();
+    let e = calibrate_gyro(&t, &still, &cal.intervals, &cal.accel.calibration, &opts).unwrap_err();
+    match &e {
+        CalibError::Unobservable {
+            sensor, parameter, ..
+        } => {
+            assert_eq!((*sensor, parameter.as_str()), ("gyro", "x scale"));
+        }
+        other => panic!("{other}"),
+    }
+    println!("{e}");
+    // the detector alone on the good log
+    let iv = detect_static(&t, &a, &w_moving, &StaticDetectOptions::default()).expect("detect");
+    assert_eq!(iv.len(), 31);
 }
