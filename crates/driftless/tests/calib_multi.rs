@@ -105,3 +105,364 @@ fn imu_tk_xsens_recording() {
     assert!((after - cal.accel_norm_rms_m_s2).abs() < 1e-12);
     let _ = CalibError::BadInput(String::new());
 }
+
+// ---------------------------------------------------------------------------------------
+// Simulated hand-placed poses
+// ---------------------------------------------------------------------------------------
+
+use driftless::calib::multi_position::calibrate_gyro;
+use driftless::calib::static_detect::detect_static;
+use driftless::sim::presets::Preset;
+use driftless::sim::sensor::{IdealImu, OutputKind, SensorModel, SensorOutput};
+use driftless::sim::temperature::TemperatureProfile;
+use driftless_model::linalg::Mat3;
+
+const DT: f64 = 0.01;
+const G: f64 = 9.80665;
+const REST_S: f64 = 50.0;
+const MOVE_S: f64 = 2.5;
+const HOLD_S: f64 = 4.0;
+
+/// exp([φ×]).
+fn rot(phi: Vec3) -> Mat3 {
+    let t = norm(phi);
+    if t < 1e-15 {
+        return Mat3::IDENTITY;
+    }
+    let k = Mat3::skew(phi.map(|v| v / t));
+    let k2 = k.mul_mat(&k);
+    let mut r = [[0.0; 3]; 3];
+    #[allow(clippy::needless_range_loop)]
+    for i in 0..3 {
+        for j in 0..3 {
+            r[i][j] =
+                f64::from(u8::from(i == j)) + t.sin() * k.0[i][j] + (1.0 - t.cos()) * k2.0[i][j];
+        }
+    }
+    Mat3(r)
+}
+
+/// Small deterministic generator (splitmix64) for the poses.
+struct Gen(u64);
+impl Gen {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn unit(&mut self) -> Vec3 {
+        loop {
+            let v = [0, 1, 2].map(|_| 2.0 * self.next() - 1.0);
+            let n = norm(v);
+            if n > 0.1 && n <= 1.0 {
+                return v.map(|x| x / n);
+            }
+        }
+    }
+}
+
+/// Rest at `c0`, then one move + hold per rotation vector in `moves` (body axes). Each
+/// move turns about a fixed body axis with θ(τ) = Θ(τ − sin 2πτ / 2π), τ = t/T (zero rate
+/// and acceleration at both ends). Returns the ideal rates (no Earth rate).
+fn poses(c0: Mat3, moves: &[Vec3]) -> IdealImu {
+    let mut starts = vec![c0];
+    for m in moves {
+        let last = starts[starts.len() - 1];
+        starts.push(last.mul_mat(&rot(*m)));
+    }
+    let total = REST_S + moves.len() as f64 * (MOVE_S + HOLD_S);
+    let n = (total / DT).round() as usize;
+    let up = [0.0, 0.0, -G];
+    IdealImu::from_fn(OutputKind::Rates, 0.0, DT, n, |k| {
+        let t = k as f64 * DT;
+        if t < REST_S {
+            return ([0.0; 3], starts[0].t().mul_vec(up));
+        }
+        let s = t - REST_S;
+        let i = ((s / (MOVE_S + HOLD_S)) as usize).min(moves.len() - 1);
+        let tau = ((s - i as f64 * (MOVE_S + HOLD_S)) / MOVE_S).min(1.0);
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let frac = tau - (two_pi * tau).sin() / two_pi;
+        let rate = if tau < 1.0 {
+            (1.0 - (two_pi * tau).cos()) / MOVE_S
+        } else {
+            0.0
+        };
+        let c = starts[i].mul_mat(&rot(moves[i].map(|v| v * frac)));
+        (moves[i].map(|v| v * rate), c.t().mul_vec(up))
+    })
+}
+
+/// `count` moves to random attitudes (rotation angles 60 … 180°).
+fn random_moves(rng: &mut Gen, count: usize) -> Vec<Vec3> {
+    (0..count)
+        .map(|_| {
+            let ang = (60.0 + 120.0 * rng.next()).to_radians();
+            rng.unit().map(|v| v * ang)
+        })
+        .collect()
+}
+
+fn simulate(preset: Preset, ideal: &IdealImu, seed: u64) -> (SensorModel, SensorOutput) {
+    let mut cfg = preset.config();
+    cfg.gyro.g_sensitivity_rad_s_per_m_s2 = [[0.0; 3]; 3];
+    let model = SensorModel::new(cfg).expect("model");
+    let temp = TemperatureProfile::constant(25.0).curve().expect("curve");
+    let out = model.simulate(ideal, &temp, seed).expect("simulate");
+    (model, out)
+}
+
+/// The same run's slow noise alone, on top of the ideal signal (bias instability, rate random walk, …: every
+/// stochastic term but white noise and quantization; the simulator draws each term from
+/// its own stream, so this is the realisation inside the full run).
+fn slow_noise(preset: Preset, ideal: &IdealImu, seed: u64) -> SensorOutput {
+    let mut cfg = preset.config().noise_only();
+    for n in cfg.gyro.noise.iter_mut().chain(cfg.accel.noise.iter_mut()) {
+        n.white = 0.0;
+        n.quantization = 0.0;
+    }
+    let model = SensorModel::new(cfg).expect("model");
+    let temp = TemperatureProfile::constant(25.0).curve().expect("curve");
+    model.simulate(ideal, &temp, seed).expect("simulate")
+}
+
+fn columns(out: &SensorOutput) -> (Vec<f64>, Vec<Vec3>, Vec<Vec3>) {
+    let n = out.len();
+    let t = (0..n).map(|k| out.time_s(k)).collect();
+    let a = (0..n).map(|k| out.accel_at(k)).collect();
+    let w = (0..n).map(|k| out.gyro_at(k)).collect();
+    (t, a, w)
+}
+
+fn sim_options() -> MultiPositionOptions {
+    MultiPositionOptions {
+        gravity_m_s2: G,
+        ..Default::default()
+    }
+}
+
+/// (I + S)(I + M) of triad 0 (gyro) or 1 (accel) at 25 °C, and b = b_on + b(25 °C).
+fn forward(model: &SensorModel, out: &SensorOutput, triad: usize) -> (Mat3, Vec3) {
+    let cfg = model.config();
+    let mis = if triad == 0 {
+        cfg.gyro.misalignment_rad
+    } else {
+        cfg.accel.misalignment_rad
+    };
+    let mut ipm = Mat3(mis);
+    for i in 0..3 {
+        ipm.0[i][i] += 1.0;
+    }
+    let s = Mat3::diag([0, 1, 2].map(|j| 1.0 + model.scale_factor_at(3 * triad + j, 25.0)));
+    let on = if triad == 0 {
+        out.gyro_turn_on_bias_rad_s
+    } else {
+        out.accel_turn_on_bias_m_s2
+    };
+    let b = [0, 1, 2].map(|j| on[j] + model.bias_at(3 * triad + j, 25.0));
+    (s.mul_mat(&ipm), b)
+}
+
+/// Rotation R (rows q_i: Gram–Schmidt of the rows of D_a) that makes R·D_a⁻¹ lower
+/// triangular: the accelerometer-defined body frame of the calibration.
+fn canonical(d_a: &Mat3) -> Mat3 {
+    let d = d_a.0;
+    let q0 = d[0].map(|v| v / norm(d[0]));
+    let p = driftless_model::linalg::dot(d[1], q0);
+    let r1 = sub(d[1], q0.map(|v| v * p));
+    let q1 = r1.map(|v| v / norm(r1));
+    Mat3([q0, q1, driftless_model::linalg::cross(q0, q1)])
+}
+
+#[test]
+fn simulated_poses_coverage() {
+    let mut z: Vec<f64> = Vec::new();
+    let mut worst_angle: f64 = 0.0;
+    for preset in [Preset::Consumer, Preset::Adis16465Like] {
+        for seed in 0..20u64 {
+            let mut rng = Gen(1000 + seed);
+            let moves = random_moves(&mut rng, 36);
+            let ideal = poses(Mat3::IDENTITY, &moves);
+            let seed = 7919 * seed + 1;
+            let (model, out) = simulate(preset, &ideal, seed);
+            let slow = slow_noise(preset, &ideal, seed);
+            let (t, a, w) = columns(&out);
+            let cal = calibrate_multi_position(&t, &a, &w, &sim_options()).expect("calibrate");
+            assert!(
+                cal.intervals.len().abs_diff(37) <= 1,
+                "{}",
+                cal.intervals.len()
+            );
+            worst_angle = worst_angle.max(cal.gravity_angle_rms_rad);
+            let (d_a, mut b_a) = forward(&model, &out, 1);
+            let (d_g, mut b_g) = forward(&model, &out, 0);
+            // The bias in effect during the recording: b plus the slow noise averaged as
+            // the estimator averages (accelerometer: mean of the interval means; gyro: the
+            // initial rest). White noise stays an estimation error.
+            let ni = cal.intervals.len() as f64;
+            for iv in &cal.intervals {
+                let len = iv.len() as f64;
+                for k in iv.start..iv.end {
+                    let s = sub(slow.accel_at(k), ideal.accel.at(k));
+                    for j in 0..3 {
+                        b_a[j] += s[j] / len / ni;
+                    }
+                }
+            }
+            let rest = &cal.intervals[0];
+            for k in rest.start..rest.end {
+                let s = sub(slow.gyro_at(k), ideal.gyro.at(k));
+                for j in 0..3 {
+                    b_g[j] += s[j] / rest.len() as f64;
+                }
+            }
+            let r = canonical(&d_a);
+            let m_a = r.mul_mat(&d_a.inverse().expect("invertible"));
+            let m_g = r.mul_mat(&d_g.inverse().expect("invertible"));
+            for (fit, m_true, b_true, lower) in
+                [(&cal.accel, m_a, b_a, true), (&cal.gyro, m_g, b_g, false)]
+            {
+                let bs = fit.bias_sigma();
+                let ms = fit.matrix_sigma();
+                for j in 0..3 {
+                    z.push((fit.calibration.bias[j] - b_true[j]) / bs[j]);
+                    for c in 0..3 {
+                        if lower && c > j {
+                            assert_eq!(fit.calibration.matrix.0[j][c], 0.0);
+                            assert!(m_true.0[j][c].abs() < 1e-12);
+                            continue;
+                        }
+                        z.push((fit.calibration.matrix.0[j][c] - m_true.0[j][c]) / ms.0[j][c]);
+                    }
+                }
+            }
+        }
+    }
+    let n = z.len() as f64;
+    let in196 = z.iter().filter(|v| v.abs() <= 1.96).count() as f64 / n;
+    let in3 = z.iter().filter(|v| v.abs() <= 3.0).count() as f64 / n;
+    let worst = z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    println!(
+        "coverage over {} parameters: {:.1} % within 1.96σ, {:.1} % within 3σ (largest |z| {worst:.2}); worst gravity angle RMS {:.3}°",
+        z.len(),
+        100.0 * in196,
+        100.0 * in3,
+        worst_angle.to_degrees()
+    );
+    assert!((in196 - 0.95).abs() <= 0.05, "{in196}");
+    assert!(in3 >= 0.99, "{in3}");
+}
+
+// ---------------------------------------------------------------------------------------
+// Bad input
+// ---------------------------------------------------------------------------------------
+
+fn sim_log(moves: &[Vec3], c0: Mat3) -> (Vec<f64>, Vec<Vec3>, Vec<Vec3>) {
+    let ideal = poses(c0, moves);
+    let (_, out) = simulate(Preset::Adis16465Like, &ideal, 5);
+    columns(&out)
+}
+
+#[test]
+fn too_few_intervals() {
+    let mut rng = Gen(7);
+    let (t, a, w) = sim_log(&random_moves(&mut rng, 5), Mat3::IDENTITY);
+    let e = calibrate_multi_position(&t, &a, &w, &sim_options()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            CalibError::TooFewIntervals {
+                found: 6,
+                needed: 10
+            }
+        ),
+        "{e}"
+    );
+    println!("{e}");
+}
+
+#[test]
+fn all_poses_z_up_leave_x_scale_unobservable() {
+    // body z up (specific force +g on z), then small tilts (≤ 10°) about horizontal axes
+    let mut rng = Gen(11);
+    let moves: Vec<Vec3> = (0..20)
+        .map(|i| {
+            let a = (8.0 * (rng.next() - 0.5)).to_radians() * if i % 2 == 0 { 1.0 } else { -1.0 };
+            [a, 0.5 * a, 0.0]
+        })
+        .collect();
+    let c0 = rot([std::f64::consts::PI, 0.0, 0.0]);
+    let (t, a, w) = sim_log(&moves, c0);
+    let e = calibrate_multi_position(&t, &a, &w, &sim_options()).unwrap_err();
+    match &e {
+        CalibError::Unobservable {
+            sensor, parameter, ..
+        } => {
+            assert_eq!((*sensor, parameter.as_str()), ("accelerometer", "x scale"));
+        }
+        other => panic!("{other}"),
+    }
+    println!("{e}");
+}
+
+#[test]
+fn saturated_axis_is_named() {
+    let mut rng = Gen(3);
+    let (t, mut a, w) = sim_log(&random_moves(&mut rng, 30), Mat3::IDENTITY);
+    // an x accelerometer with a rail at +0.8 g: poses with x up clip
+    let rail = 0.8 * G;
+    for v in &mut a {
+        v[0] = v[0].min(rail);
+    }
+    let opts = MultiPositionOptions {
+        accel_range_raw: Some([-2.0 * G, rail]),
+        ..sim_options()
+    };
+    let e = calibrate_multi_position(&t, &a, &w, &opts).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            CalibError::Saturated {
+                sensor: "accelerometer",
+                axis: 'x',
+                ..
+            }
+        ),
+        "{e}"
+    );
+    println!("{e}");
+}
+
+#[test]
+fn all_static_log_leaves_gyro_scale_unobservable() {
+    // a whole static log is one interval
+    let ideal = poses(Mat3::IDENTITY, &[[0.0; 3]]);
+    let (_, out) = simulate(Preset::Adis16465Like, &ideal, 9);
+    let (t, a, w) = columns(&out);
+    let e = calibrate_multi_position(&t, &a, &w, &sim_options()).unwrap_err();
+    assert!(
+        matches!(e, CalibError::TooFewIntervals { found: 1, .. }),
+        "{e}"
+    );
+    // good poses for the accelerometer, but a gyro log without rotation
+    let mut rng = Gen(4);
+    let (t, a, w_moving) = sim_log(&random_moves(&mut rng, 30), Mat3::IDENTITY);
+    let opts = sim_options();
+    let cal = calibrate_multi_position(&t, &a, &w_moving, &opts).expect("good log");
+    let still: Vec<Vec3> = (0..t.len()).map(|k| w[k % w.len()]).collect();
+    let e = calibrate_gyro(&t, &still, &cal.intervals, &cal.accel.calibration, &opts).unwrap_err();
+    match &e {
+        CalibError::Unobservable {
+            sensor, parameter, ..
+        } => {
+            assert_eq!((*sensor, parameter.as_str()), ("gyro", "x scale"));
+        }
+        other => panic!("{other}"),
+    }
+    println!("{e}");
+    // the detector alone on the good log
+    let iv = detect_static(&t, &a, &w_moving, &StaticDetectOptions::default()).expect("detect");
+    assert_eq!(iv.len(), 31);
+}

@@ -413,7 +413,7 @@ pub fn calibrate_accel(
         }
     }
     let c = raw.iter().map(|a| norm(sub(*a, b0))).sum::<f64>() / m as f64;
-    if !(c > 0.0) {
+    if c.is_nan() || c <= 0.0 {
         return Err(CalibError::BadInput(
             "all static intervals have the same mean reading".into(),
         ));
@@ -432,9 +432,9 @@ pub fn calibrate_accel(
             if let Some(j) = jac.as_deref_mut() {
                 let u = cal.map(|v| v / n.max(1e-300));
                 let row = &mut j[i * 9..(i + 1) * 9];
-                for q in 0..3 {
+                for (q, v) in row[..3].iter_mut().enumerate() {
                     // ∂r/∂β_q = −uᵀ M e_q
-                    row[q] = -(u[0] * mm.0[0][q] + u[1] * mm.0[1][q] + u[2] * mm.0[2][q]);
+                    *v = -(u[0] * mm.0[0][q] + u[1] * mm.0[1][q] + u[2] * mm.0[2][q]);
                 }
                 // ∂cal/∂k_q = T[:, q] d_q
                 row[3] = (u[0] + u[1] * p[6] + u[2] * p[7]) * d[0];
