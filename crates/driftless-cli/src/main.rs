@@ -6,6 +6,7 @@
 
 mod allan_cmd;
 mod bench_cmd;
+mod calibrate_cmd;
 mod convert_cmd;
 mod demo_cmd;
 mod input;
@@ -32,6 +33,9 @@ struct Cli {
 enum Command {
     /// Allan-family deviations, confidence intervals and IMU noise terms of a log.
     Allan(allan_cmd::AllanArgs),
+    /// Room-temperature calibration (bias, scale, misalignment with σ): six-position +
+    /// rate table, or multi-position without fixtures.
+    Calibrate(calibrate_cmd::CalibrateArgs),
     /// Convert a delimited text log to the compact binary log format (or back).
     Convert(convert_cmd::ConvertArgs),
     /// Speed benchmarks (parse, binary read, exact and fast OADEV) on generated data.
@@ -50,6 +54,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Allan(a) => allan_cmd::run(a),
         Command::Convert(a) => convert_cmd::run(a),
+        Command::Calibrate(a) => calibrate_cmd::run(a),
         Command::Demo(a) => demo_cmd::run(a),
         Command::Bench(a) => bench_cmd::run(a),
         Command::Nav(a) => nav_cmd::run(a),

@@ -77,6 +77,10 @@ pub struct CalibrationFile {
     /// Static intervals used, [start, end] s.
     #[serde(default)]
     pub static_intervals: Vec<[f64; 2]>,
+    /// Gyro g-sensitivity G (raw gyro units per m/s² of specific force, raw = … + G·f),
+    /// when estimated.
+    #[serde(default)]
+    pub gyro_g_sensitivity: Option<[[f64; 3]; 3]>,
 }
 
 /// Why a calibration file could not be read or written.
@@ -215,6 +219,7 @@ mod tests {
             accel: t("counts", 32768.0, 2.4e-3),
             gyro: t("counts", 32768.0, 1.6e-4),
             static_intervals: vec![[0.0, 50.0], [55.0, 60.0]],
+            gyro_g_sensitivity: None,
         }
     }
 

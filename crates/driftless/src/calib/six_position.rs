@@ -778,6 +778,33 @@ impl SixPositionInput {
             OutputKind::Rates => 1.0,
             OutputKind::Increments => 1.0 / out.dt_s,
         };
+        SixPositionInput::from_manifest_columns(
+            manifest,
+            &out.accel,
+            &out.gyro,
+            scale,
+            set_temperature_c,
+        )
+    }
+
+    /// The positions and rate segments of `manifest` at `set_temperature_c` from raw
+    /// sample columns (x, y, z) indexed as the manifest's samples (sample k at
+    /// k/`sample_rate_hz` from the protocol start), each multiplied by `scale` (1 for
+    /// rates; 1/Δt for increments).
+    pub fn from_manifest_columns(
+        manifest: &ChamberManifest,
+        accel: &[Vec<f64>; 3],
+        gyro: &[Vec<f64>; 3],
+        scale: f64,
+        set_temperature_c: f64,
+    ) -> Result<SixPositionInput, SixPositionError> {
+        let fs = manifest.sample_rate_hz;
+        let len = accel[0].len();
+        if accel.iter().chain(gyro).any(|c| c.len() != len) {
+            return Err(SixPositionError::Invalid(
+                "accelerometer and gyro columns differ in length".into(),
+            ));
+        }
         let mut input = SixPositionInput::default();
         for seg in manifest
             .segments
@@ -785,16 +812,14 @@ impl SixPositionInput {
             .filter(|s| s.set_temperature_c == set_temperature_c)
         {
             let range = seg.sample_range(fs);
-            if range.is_empty() || range.end > out.len() {
+            if range.is_empty() || range.end > len {
                 if matches!(
                     seg.kind,
                     SegmentKind::Position { .. } | SegmentKind::Rate { .. }
                 ) {
                     return Err(SixPositionError::Invalid(format!(
-                        "segment {:.3}–{:.3} s: samples {range:?} not inside the {} recorded",
-                        seg.start_s,
-                        seg.end_s,
-                        out.len()
+                        "segment {:.3}–{:.3} s: samples {range:?} not inside the {len} recorded",
+                        seg.start_s, seg.end_s,
                     )));
                 }
                 continue;
@@ -802,8 +827,8 @@ impl SixPositionInput {
             let n = range.len();
             match seg.kind {
                 SegmentKind::Position { up } => {
-                    let (am, asd, apk) = triad_stats(&out.accel, range.clone(), scale);
-                    let (gm, gsd, gpk) = triad_stats(&out.gyro, range, scale);
+                    let (am, asd, apk) = triad_stats(accel, range.clone(), scale);
+                    let (gm, gsd, gpk) = triad_stats(gyro, range, scale);
                     input.positions.push(PositionMean {
                         up,
                         c_bn: up.c_bn_up(),
@@ -817,7 +842,7 @@ impl SixPositionInput {
                     });
                 }
                 SegmentKind::Rate { axis, rate_rad_s } => {
-                    let (gm, gsd, gpk) = triad_stats(&out.gyro, range, scale);
+                    let (gm, gsd, gpk) = triad_stats(gyro, range, scale);
                     input.rates.push(RateMean {
                         axis,
                         rate_rad_s,

@@ -1,0 +1,427 @@
+//! `driftless calibrate six-position|multi-position`: room-temperature calibration
+//! calibrated = M·(raw − b) of both triads, with σ, written as a calibration model file
+//! (`--out`), printed as tables or as `--json`:
+//! `{"accel":{"bias":[3],"matrix":[[3],[3],[3]],…},"gyro":{…},"static_intervals":[[t0,t1],…]}`
+//! (SI: m/s², rad/s; raw in the input's units).
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Subcommand};
+use driftless::calib::model_file::{CalibrationFile, FORMAT_VERSION, TriadEntry};
+use driftless::calib::multi_position::{MultiPositionOptions, calibrate_multi_position};
+use driftless::calib::six_position::{SixPositionInput, SixPositionOptions, calibrate};
+use driftless::io::{ImuLog, Quantity};
+use driftless::sim::chamber_manifest::ChamberManifest;
+use driftless_model::calib::TriadCalibration;
+use driftless_model::linalg::Vec3;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::input::InputArgs;
+
+#[derive(Args, Debug)]
+pub struct CalibrateArgs {
+    #[command(subcommand)]
+    pub method: Method,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Method {
+    /// Fixture-free calibration from hand-placed static poses (Tedaldi et al. 2014): the
+    /// log starts at rest, then many static orientations with rotations in between.
+    MultiPosition(MultiArgs),
+    /// Six-position + rate-table calibration from a log and its segment manifest (the
+    /// `manifest.toml` of a chamber protocol: positions and ±ω segments).
+    SixPosition(SixArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct Common {
+    /// Gravity magnitude, m/s² (default: normal gravity at --lat-deg / --height-m).
+    #[arg(long, value_name = "M_S2")]
+    pub gravity: Option<f64>,
+    /// Site latitude for normal gravity, deg.
+    #[arg(long, default_value_t = 45.0, allow_hyphen_values = true)]
+    pub lat_deg: f64,
+    /// Site height for normal gravity, m.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub height_m: f64,
+    /// Write the calibration model file here (TOML).
+    #[arg(long, value_name = "FILE.toml")]
+    pub out: Option<PathBuf>,
+    /// Machine-readable output.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub input: InputArgs,
+}
+
+#[derive(Args, Debug)]
+pub struct MultiArgs {
+    /// Accelerometer log (time + x, y, z), or one log with both triads (then give no
+    /// GYRO: channels by quantity, or the first three = accel, next three = gyro).
+    pub accel: PathBuf,
+    /// Gyro log (time + x, y, z), sampled with the accelerometer.
+    pub gyro: Option<PathBuf>,
+    /// Gyro raw scale guess, rad/s per raw unit (1 when the log is in rad/s or in units
+    /// the reader converts; e.g. 1.6e-4 for 16-bit counts at ±300 deg/s). Within ±20 %.
+    #[arg(long, default_value_t = 1.0)]
+    pub gyro_scale_guess: f64,
+    /// Accelerometer zero offset, raw units (e.g. 32768 for offset-binary counts; the
+    /// starting bias and the origin for classifying poses). Default: per axis, the
+    /// middle of the 1st and 99th percentiles of the log.
+    #[arg(long, value_name = "RAW", allow_hyphen_values = true)]
+    pub accel_offset: Option<f64>,
+    #[command(flatten)]
+    pub common: Common,
+}
+
+#[derive(Args, Debug)]
+pub struct SixArgs {
+    /// IMU log: time + gyro x, y, z + accel x, y, z (the `imu.csv` of `driftless
+    /// simulate`; channels by quantity or name), sample k at k/rate from the protocol
+    /// start.
+    pub log: PathBuf,
+    /// Segment manifest (TOML) naming each static position and rate-table segment.
+    #[arg(long)]
+    pub manifest: PathBuf,
+    /// Set temperature to use when the manifest has several, °C.
+    #[arg(long, allow_hyphen_values = true)]
+    pub temperature_c: Option<f64>,
+    /// Also estimate the gyro g-sensitivity (3 × 3, raw per m/s²) from the positions.
+    #[arg(long)]
+    pub g_sensitivity: bool,
+    #[command(flatten)]
+    pub common: Common,
+}
+
+pub fn run(a: CalibrateArgs) -> Result<()> {
+    match a.method {
+        Method::MultiPosition(m) => multi(m),
+        Method::SixPosition(s) => six(s),
+    }
+}
+
+fn gravity(c: &Common) -> Result<f64> {
+    let g = match c.gravity {
+        Some(g) => g,
+        None => driftless::calib::multi_position::gravity_at(c.lat_deg.to_radians(), c.height_m),
+    };
+    if !(g.is_finite() && (9.7..=9.9).contains(&g)) {
+        bail!("--gravity {g} m/s² is not an Earth gravity (9.7–9.9)");
+    }
+    Ok(g)
+}
+
+/// Reads a log with the time in column 1 unless told otherwise.
+fn read(input: &InputArgs, path: &Path) -> Result<ImuLog> {
+    let mut input = input.clone();
+    input.time_column.get_or_insert_with(|| "1".into());
+    input.read(path)
+}
+
+/// Three columns of `log` as vectors: by quantity when it has exactly three of it,
+/// else the channels at `first..first + 3`.
+fn triad(log: &ImuLog, q: Quantity, first: usize, what: &str) -> Result<Vec<Vec3>> {
+    let by_q: Vec<usize> = (0..log.channels.len())
+        .filter(|&i| log.channels[i].quantity == q)
+        .collect();
+    let idx: Vec<usize> = if by_q.len() == 3 {
+        by_q
+    } else {
+        (first..first + 3).collect()
+    };
+    if idx.iter().any(|&i| i >= log.channels.len()) {
+        bail!(
+            "{}: needs three {what} columns, found {} data columns",
+            log.source,
+            log.channels.len()
+        );
+    }
+    let c = |k: usize| &log.channels[idx[k]].values;
+    Ok((0..log.len())
+        .map(|i| [c(0)[i], c(1)[i], c(2)[i]])
+        .collect())
+}
+
+fn columns(v: &[Vec3]) -> [Vec<f64>; 3] {
+    std::array::from_fn(|k| v.iter().map(|x| x[k]).collect())
+}
+
+fn entry(
+    cal: &TriadCalibration,
+    bias_sigma: Vec3,
+    matrix_sigma: [[f64; 3]; 3],
+    unit: &str,
+    rms: Option<f64>,
+) -> TriadEntry {
+    TriadEntry {
+        raw_unit: unit.into(),
+        bias: cal.bias,
+        bias_sigma,
+        matrix: cal.matrix.0,
+        matrix_sigma,
+        residual_rms: rms,
+    }
+}
+
+fn raw_unit(log: &ImuLog, q: Quantity) -> String {
+    match log.channels.iter().find(|c| c.quantity == q) {
+        Some(_) => q.si_unit().to_string(),
+        None => "raw".into(),
+    }
+}
+
+fn multi(m: MultiArgs) -> Result<()> {
+    let g = gravity(&m.common)?;
+    let acc_log = read(&m.common.input, &m.accel)?;
+    let (accel, gyro, gyro_log) = match &m.gyro {
+        Some(p) => {
+            let gl = read(&m.common.input, p)?;
+            if gl.len() != acc_log.len() {
+                bail!(
+                    "{} has {} samples, {} has {}: the two files must be sampled together",
+                    m.accel.display(),
+                    acc_log.len(),
+                    p.display(),
+                    gl.len()
+                );
+            }
+            (
+                triad(&acc_log, Quantity::SpecificForce, 0, "accelerometer")?,
+                triad(&gl, Quantity::AngularRate, 0, "gyro")?,
+                gl,
+            )
+        }
+        None => (
+            triad(&acc_log, Quantity::SpecificForce, 0, "accelerometer")?,
+            triad(&acc_log, Quantity::AngularRate, 3, "gyro")?,
+            acc_log.clone(),
+        ),
+    };
+    let Some(time) = acc_log.time_s.clone() else {
+        bail!("{}: no time column", m.accel.display());
+    };
+    let offset: Vec3 = match m.accel_offset {
+        Some(o) => [o; 3],
+        None => std::array::from_fn(|k| {
+            let mut v: Vec<f64> = accel.iter().map(|a| a[k]).collect();
+            v.sort_by(f64::total_cmp);
+            let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+            0.5 * (at(0.01) + at(0.99))
+        }),
+    };
+    let mut opts = MultiPositionOptions {
+        gravity_m_s2: g,
+        gyro_scale_guess_rad_s_per_raw: m.gyro_scale_guess,
+        ..MultiPositionOptions::default()
+    };
+    opts.detect.accel_offset_raw = offset;
+    let t = Instant::now();
+    let res = calibrate_multi_position(&time, &accel, &gyro, &opts)
+        .with_context(|| format!("calibrating {}", m.accel.display()))?;
+    let secs = t.elapsed().as_secs_f64();
+    let intervals: Vec<[f64; 2]> = res
+        .intervals
+        .iter()
+        .map(|iv| [iv.start_time_s, iv.end_time_s])
+        .collect();
+    let file = CalibrationFile {
+        format_version: FORMAT_VERSION,
+        method: "multi-position".into(),
+        source: match &m.gyro {
+            Some(p) => format!("{} + {}", m.accel.display(), p.display()),
+            None => m.accel.display().to_string(),
+        },
+        gravity_m_s2: g,
+        accel: entry(
+            &res.accel.calibration,
+            res.accel.bias_sigma(),
+            res.accel.matrix_sigma().0,
+            &raw_unit(&acc_log, Quantity::SpecificForce),
+            Some(res.accel_norm_rms_m_s2),
+        ),
+        gyro: entry(
+            &res.gyro.calibration,
+            res.gyro.bias_sigma(),
+            res.gyro.matrix_sigma().0,
+            &raw_unit(&gyro_log, Quantity::AngularRate),
+            Some(res.gravity_angle_rms_rad),
+        ),
+        static_intervals: intervals,
+        gyro_g_sensitivity: None,
+    };
+    let summary = [
+        ("static intervals", format!("{}", res.intervals.len())),
+        ("threshold multiple", format!("{}", res.threshold_multiple)),
+        (
+            "RMS |a| − g after",
+            format!("{:.5} m/s²", res.accel_norm_rms_m_s2),
+        ),
+        (
+            "gravity direction after integrating the gyro, RMS",
+            format!("{:.3}°", res.gravity_angle_rms_rad.to_degrees()),
+        ),
+        ("time", format!("{:.3} s", secs)),
+    ];
+    output(&m.common, &file, &summary, secs)
+}
+
+fn six(s: SixArgs) -> Result<()> {
+    let text = std::fs::read_to_string(&s.manifest)
+        .with_context(|| format!("reading {}", s.manifest.display()))?;
+    let manifest = ChamberManifest::from_toml_str(&text)
+        .with_context(|| format!("{}", s.manifest.display()))?;
+    let mut temps: Vec<f64> = manifest
+        .segments
+        .iter()
+        .map(|x| x.set_temperature_c)
+        .collect();
+    temps.sort_by(f64::total_cmp);
+    temps.dedup();
+    let temp = match (s.temperature_c, temps.as_slice()) {
+        (Some(t), _) if temps.contains(&t) => t,
+        (Some(t), _) => bail!("--temperature-c {t}: the manifest's set temperatures are {temps:?}"),
+        (None, [t]) => *t,
+        (None, _) => bail!(
+            "{}: {} set temperatures ({temps:?}); choose one with --temperature-c",
+            s.manifest.display(),
+            temps.len()
+        ),
+    };
+    let log = read(&s.common.input, &s.log)?;
+    let rate = 1.0 / log.tau0_s;
+    if (rate - manifest.sample_rate_hz).abs() > 1e-6 * rate {
+        bail!(
+            "{} is sampled at {rate} Hz, the manifest at {} Hz",
+            s.log.display(),
+            manifest.sample_rate_hz
+        );
+    }
+    let gyro = triad(&log, Quantity::AngularRate, 0, "gyro")?;
+    let accel = triad(&log, Quantity::SpecificForce, 3, "accelerometer")?;
+    let input = SixPositionInput::from_manifest_columns(
+        &manifest,
+        &columns(&accel),
+        &columns(&gyro),
+        1.0,
+        temp,
+    )?;
+    let mut opts = SixPositionOptions::from_manifest(&manifest);
+    opts.estimate_g_sensitivity = s.g_sensitivity;
+    if s.common.gravity.is_some() {
+        opts.gravity_m_s2 = gravity(&s.common)?;
+    }
+    let t = Instant::now();
+    let res = calibrate(&input, &opts)?;
+    let secs = t.elapsed().as_secs_f64();
+    let file = CalibrationFile {
+        format_version: FORMAT_VERSION,
+        method: "six-position".into(),
+        source: format!("{} + {}", s.log.display(), s.manifest.display()),
+        gravity_m_s2: opts.gravity_m_s2,
+        accel: entry(
+            &res.accel.calibration,
+            res.accel.bias_sigma(),
+            res.accel.matrix_sigma(),
+            &raw_unit(&log, Quantity::SpecificForce),
+            None,
+        ),
+        gyro: entry(
+            &res.gyro.calibration,
+            res.gyro.bias_sigma(),
+            res.gyro.matrix_sigma(),
+            &raw_unit(&log, Quantity::AngularRate),
+            None,
+        ),
+        static_intervals: Vec::new(),
+        gyro_g_sensitivity: res
+            .gyro_g_sensitivity
+            .as_ref()
+            .map(|g| g.matrix_raw_per_m_s2.0),
+    };
+    let summary = [
+        ("positions", format!("{}", input.positions.len())),
+        ("rate segments", format!("{}", input.rates.len())),
+        ("set temperature", format!("{temp} °C")),
+        (
+            "χ²/dof accel, gyro",
+            format!(
+                "{:.2}, {:.2}",
+                res.accel.chi2_per_dof(),
+                res.gyro.chi2_per_dof()
+            ),
+        ),
+        ("time", format!("{:.4} s", secs)),
+    ];
+    output(&s.common, &file, &summary, secs)
+}
+
+fn triad_json(t: &TriadEntry) -> serde_json::Value {
+    serde_json::json!({
+        "bias": t.bias,
+        "bias_sigma": t.bias_sigma,
+        "matrix": t.matrix,
+        "matrix_sigma": t.matrix_sigma,
+        "raw_unit": t.raw_unit,
+        "residual_rms": t.residual_rms,
+    })
+}
+
+fn output(c: &Common, file: &CalibrationFile, summary: &[(&str, String)], secs: f64) -> Result<()> {
+    if let Some(p) = &c.out {
+        file.save(p)?;
+    }
+    if c.json {
+        let v = serde_json::json!({
+            "method": file.method,
+            "gravity_m_s2": file.gravity_m_s2,
+            "accel": triad_json(&file.accel),
+            "gyro": triad_json(&file.gyro),
+            "static_intervals": file.static_intervals,
+            "gyro_g_sensitivity": file.gyro_g_sensitivity,
+            "seconds": secs,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    for (k, v) in summary {
+        println!("{k}: {v}");
+    }
+    for (name, t, unit) in [
+        ("accelerometer", &file.accel, "m/s²"),
+        ("gyro", &file.gyro, "rad/s"),
+    ] {
+        println!(
+            "\n{name}: calibrated [{unit}] = M · (raw − b); raw unit: {}",
+            t.raw_unit
+        );
+        let mut tab = crate::output::Table::new(["", "b", "σ(b)", "M · x", "M · y", "M · z"]);
+        for (i, ax) in ["x", "y", "z"].iter().enumerate() {
+            tab.row(vec![
+                ax.to_string(),
+                crate::output::sci(t.bias[i]),
+                crate::output::sci(t.bias_sigma[i]),
+                format!(
+                    "{} ± {}",
+                    crate::output::sci(t.matrix[i][0]),
+                    crate::output::sci(t.matrix_sigma[i][0])
+                ),
+                format!(
+                    "{} ± {}",
+                    crate::output::sci(t.matrix[i][1]),
+                    crate::output::sci(t.matrix_sigma[i][1])
+                ),
+                format!(
+                    "{} ± {}",
+                    crate::output::sci(t.matrix[i][2]),
+                    crate::output::sci(t.matrix_sigma[i][2])
+                ),
+            ]);
+        }
+        print!("{}", tab.render());
+    }
+    if let Some(p) = &c.out {
+        println!("\nwrote {}", p.display());
+    }
+    Ok(())
+}
