@@ -250,6 +250,20 @@ fn multi(m: MultiArgs) -> Result<()> {
         static_intervals: intervals,
         gyro_g_sensitivity: None,
     };
+    let residuals: Vec<Vec<String>> = res
+        .intervals
+        .iter()
+        .enumerate()
+        .map(|(i, iv)| {
+            let a = res.accel.calibration.apply(iv.mean_accel_raw);
+            vec![
+                format!("{}", i + 1),
+                format!("{:.2}–{:.2}", iv.start_time_s, iv.end_time_s),
+                format!("{:?}", iv.orientation),
+                format!("{:+.5}", driftless_model::linalg::norm(a) - g),
+            ]
+        })
+        .collect();
     let summary = [
         ("static intervals", format!("{}", res.intervals.len())),
         ("threshold multiple", format!("{}", res.threshold_multiple)),
@@ -263,7 +277,13 @@ fn multi(m: MultiArgs) -> Result<()> {
         ),
         ("time", format!("{:.3} s", secs)),
     ];
-    output(&m.common, &file, &summary, secs)
+    output(
+        &m.common,
+        &file,
+        &summary,
+        secs,
+        (["#", "interval [s]", "pose", "|a| − g [m/s²]"], residuals),
+    )
 }
 
 fn six(s: SixArgs) -> Result<()> {
@@ -339,6 +359,22 @@ fn six(s: SixArgs) -> Result<()> {
             .as_ref()
             .map(|g| g.matrix_raw_per_m_s2.0),
     };
+    let g = opts.gravity_m_s2;
+    let residuals: Vec<Vec<String>> = input
+        .positions
+        .iter()
+        .map(|p| {
+            let a = res.accel.calibration.apply(p.accel_raw);
+            let want = p.c_bn.t().mul_vec([0.0, 0.0, -g]);
+            let d = driftless_model::linalg::sub(a, want);
+            vec![
+                format!("{}", p.up),
+                format!("{}", p.n),
+                format!("{:+.2e} {:+.2e} {:+.2e}", d[0], d[1], d[2]),
+                format!("{:+.2e}", driftless_model::linalg::norm(a) - g),
+            ]
+        })
+        .collect();
     let summary = [
         ("positions", format!("{}", input.positions.len())),
         ("rate segments", format!("{}", input.rates.len())),
@@ -353,7 +389,16 @@ fn six(s: SixArgs) -> Result<()> {
         ),
         ("time", format!("{:.4} s", secs)),
     ];
-    output(&s.common, &file, &summary, secs)
+    output(
+        &s.common,
+        &file,
+        &summary,
+        secs,
+        (
+            ["up", "samples", "a − g·up (x y z) [m/s²]", "|a| − g [m/s²]"],
+            residuals,
+        ),
+    )
 }
 
 fn triad_json(t: &TriadEntry) -> serde_json::Value {
@@ -367,7 +412,13 @@ fn triad_json(t: &TriadEntry) -> serde_json::Value {
     })
 }
 
-fn output(c: &Common, file: &CalibrationFile, summary: &[(&str, String)], secs: f64) -> Result<()> {
+fn output(
+    c: &Common,
+    file: &CalibrationFile,
+    summary: &[(&str, String)],
+    secs: f64,
+    residuals: ([&str; 4], Vec<Vec<String>>),
+) -> Result<()> {
     if let Some(p) = &c.out {
         file.save(p)?;
     }
@@ -384,6 +435,13 @@ fn output(c: &Common, file: &CalibrationFile, summary: &[(&str, String)], secs: 
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
+    let mut tab = crate::output::Table::new(residuals.0);
+    for row in residuals.1 {
+        tab.row(row);
+    }
+    println!("residuals of the calibrated accelerometer per static interval:");
+    print!("{}", tab.render());
+    println!();
     for (k, v) in summary {
         println!("{k}: {v}");
     }
