@@ -63,6 +63,10 @@ pub struct NavArgs {
     /// Antenna lever arm from the IMU in the body frame, forward,right,down [m].
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub lever_arm: Option<String>,
+    /// Apply a calibration model file (`driftless calibrate --out`) to the IMU before
+    /// navigation; its raw units must be SI (rad/s, m/s²), as the IMU readers deliver.
+    #[arg(long, value_name = "FILE.toml")]
+    pub calibration: Option<PathBuf>,
     /// IMU noise from an Allan noise-model file (`driftless allan --save-model`); default
     /// consumer-MEMS values.
     #[arg(long)]
@@ -154,6 +158,22 @@ pub fn run(a: NavArgs) -> Result<()> {
             )?
         }
     };
+    let mut imu = imu;
+    if let Some(p) = &a.calibration {
+        let f = driftless::calib::model_file::CalibrationFile::load(p)?;
+        for (t, si) in [(&f.accel, ["m/s^2", "m/s²"]), (&f.gyro, ["rad/s", "rad/s"])] {
+            if !si.contains(&t.raw_unit.as_str()) {
+                bail!(
+                    "{}: raw unit {:?}: nav reads SI samples, so it can apply only a \
+                     calibration of SI samples ({} / rad/s)",
+                    p.display(),
+                    t.raw_unit,
+                    si[0]
+                );
+            }
+        }
+        imu.apply_calibration(&f.calibration());
+    }
     let gnss = read_gnss_file(&gnss_file, &GnssReadOptions::default())?;
     let lever = match (&a.lever_arm, a.preset) {
         (Some(s), _) => parse_vec3(s, "--lever-arm")?,

@@ -220,6 +220,54 @@ fn generic_rate_csv_runs() {
     // must bridge it at the cm level.
     assert!(end < 20.0, "outage end error {end} m");
     assert!(smoothed < 0.1, "smoothed in-outage max {smoothed} m");
+    // A calibration file: identity in SI changes nothing; one of raw counts is refused.
+    let cal = |unit: &str| {
+        format!(
+            "format_version = 1\nmethod = \"test\"\nsource = \"t\"\ngravity_m_s2 = 9.8\n\
+             [accel]\nraw_unit = \"{unit}\"\nbias = [0.0, 0.0, 0.0]\nbias_sigma = [0.0, 0.0, 0.0]\n\
+             matrix = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\n\
+             matrix_sigma = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]\n\
+             [gyro]\nraw_unit = \"rad/s\"\nbias = [0.0, 0.0, 0.0]\nbias_sigma = [0.0, 0.0, 0.0]\n\
+             matrix = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\n\
+             matrix_sigma = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]\n"
+        )
+    };
+    std::fs::write(dir.join("cal.toml"), cal("m/s^2")).unwrap();
+    std::fs::write(dir.join("cal_counts.toml"), cal("counts")).unwrap();
+    let base = [
+        "nav",
+        "--imu",
+        "imu.csv",
+        "--imu-format",
+        "csv",
+        "--gnss",
+        "gnss.txt",
+    ];
+    let with = bin()
+        .current_dir(&dir)
+        .args(base)
+        .args(["--outages", "60+20", "--json", "--calibration", "cal.toml"])
+        .output()
+        .unwrap();
+    assert!(
+        with.status.success(),
+        "{}",
+        String::from_utf8_lossy(&with.stderr)
+    );
+    let w: serde_json::Value = serde_json::from_slice(&with.stdout).unwrap();
+    assert_eq!(w["horizontal_rms_m"], v["horizontal_rms_m"]);
+    let bad = bin()
+        .current_dir(&dir)
+        .args(base)
+        .args(["--calibration", "cal_counts.toml"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("cal_counts.toml") && err.contains("counts"),
+        "{err}"
+    );
     // A rate column without a unit cannot be used: its scale is unknown.
     std::fs::write(
         dir.join("bad.csv"),

@@ -334,6 +334,23 @@ impl ImuStream {
             end_s: self.epochs.last()?.time_s,
         })
     }
+
+    /// Applies a room-temperature calibration whose raw units are SI (rad/s, m/s²) to
+    /// the increments: Δθ' = M_g(Δθ − b_g·Δt), Δv' = M_a(Δv − b_a·Δt) — the rate model
+    /// calibrated = M·(raw − b) integrated over each interval (exact for constant M, b).
+    pub fn apply_calibration(&mut self, cal: &driftless_model::calib::ImuCalibration) {
+        use driftless_model::linalg::{scale, sub};
+        for e in &mut self.epochs {
+            e.dtheta_rad = cal
+                .gyro
+                .matrix
+                .mul_vec(sub(e.dtheta_rad, scale(cal.gyro.bias, e.dt_s)));
+            e.dvel_m_s = cal
+                .accel
+                .matrix
+                .mul_vec(sub(e.dvel_m_s, scale(cal.accel.bias, e.dt_s)));
+        }
+    }
 }
 
 /// Median of the successive differences of a strictly increasing series (len ≥ 2).
@@ -870,4 +887,43 @@ pub fn select_gnss(
         masked,
         usable_span: Some(usable_span),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use driftless_model::calib::{ImuCalibration, TriadCalibration};
+
+    #[test]
+    fn calibration_applies_to_increments_as_to_rates() {
+        let dt = 0.01;
+        let mut s = ImuStream {
+            nominal_dt_s: dt,
+            epochs: vec![ImuIncrement {
+                time_s: 1.0,
+                dt_s: dt,
+                dtheta_rad: [0.02 * dt, -0.01 * dt, 0.5 * dt],
+                dvel_m_s: [0.3 * dt, 0.1 * dt, -9.8 * dt],
+            }],
+            ..ImuStream::default()
+        };
+        let m = Mat3([[1.01, 0.002, 0.0], [0.0, 0.99, -0.001], [0.003, 0.0, 1.0]]);
+        let cal = ImuCalibration {
+            gyro: TriadCalibration {
+                bias: [0.01, 0.0, -0.02],
+                matrix: m,
+            },
+            accel: TriadCalibration {
+                bias: [0.1, -0.2, 0.05],
+                matrix: m,
+            },
+        };
+        s.apply_calibration(&cal);
+        let w = cal.gyro.apply([0.02, -0.01, 0.5]);
+        let f = cal.accel.apply([0.3, 0.1, -9.8]);
+        for k in 0..3 {
+            assert!((s.epochs[0].dtheta_rad[k] - w[k] * dt).abs() < 1e-15);
+            assert!((s.epochs[0].dvel_m_s[k] - f[k] * dt).abs() < 1e-14);
+        }
+    }
 }
