@@ -264,8 +264,30 @@ fn multi(m: MultiArgs) -> Result<()> {
             ]
         })
         .collect();
+    // Before: the nominal zero offset and the best single scale s (least squares of
+    // s·|ā − o| = g over the intervals: s = g·Σ|r| / Σ|r|²).
+    let r: Vec<f64> = res
+        .intervals
+        .iter()
+        .map(|iv| {
+            driftless_model::linalg::norm(driftless_model::linalg::sub(iv.mean_accel_raw, offset))
+        })
+        .collect();
+    let single = g * r.iter().sum::<f64>() / r.iter().map(|v| v * v).sum::<f64>().max(1e-300);
+    let before = driftless::calib::multi_position::accel_norm_rms(
+        &res.intervals,
+        &TriadCalibration {
+            bias: offset,
+            matrix: driftless_model::linalg::Mat3::diag([single; 3]),
+        },
+        g,
+    );
     let summary = [
         ("static intervals", format!("{}", res.intervals.len())),
+        (
+            "RMS |a| − g before (nominal offset, best single scale)",
+            format!("{before:.5} m/s²"),
+        ),
         ("threshold multiple", format!("{}", res.threshold_multiple)),
         (
             "RMS |a| − g after",
@@ -430,6 +452,7 @@ fn output(
             "gyro": triad_json(&file.gyro),
             "static_intervals": file.static_intervals,
             "gyro_g_sensitivity": file.gyro_g_sensitivity,
+            "summary": summary.iter().map(|(k, v)| (k.to_string(), v.clone())).collect::<std::collections::BTreeMap<_, _>>(),
             "seconds": secs,
         });
         println!("{}", serde_json::to_string_pretty(&v)?);

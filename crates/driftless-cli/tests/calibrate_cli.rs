@@ -136,4 +136,24 @@ fn multi_position_on_the_imu_tk_recording() {
     assert!(ang <= 0.52, "{ang}");
     let m = matrix(&v["gyro"]["matrix"]);
     assert!(m[0][0] > 1e-4 && m[0][0] < 3e-4, "{m:?}");
+    // One log with both triads (time, accel xyz, gyro xyz) gives the same calibration.
+    let acc = std::fs::read_to_string(d.join("xsens_acc.txt")).unwrap();
+    let gyr = std::fs::read_to_string(d.join("xsens_gyro.txt")).unwrap();
+    let mut both = String::new();
+    for (a, g) in acc.lines().zip(gyr.lines()) {
+        let gcols: Vec<&str> = g.split_whitespace().skip(1).collect();
+        both.push_str(&format!("{} {}\n", a.trim(), gcols.join(" ")));
+    }
+    let dir = std::env::temp_dir().join(format!("driftless-calxs-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("both.txt"), both).unwrap();
+    let one = run_json(
+        bin()
+            .args(["calibrate", "multi-position", "--json", "--gravity", "9.81744"])
+            .args(["--gyro-scale-guess", "1.598e-4"])
+            .arg(dir.join("both.txt")),
+    );
+    assert_eq!(one["accel"]["matrix"], v["accel"]["matrix"]);
+    assert_eq!(one["gyro"]["bias"], v["gyro"]["bias"]);
+    let _ = std::fs::remove_dir_all(&dir);
 }
