@@ -149,7 +149,13 @@ fn multi_position_on_the_imu_tk_recording() {
     std::fs::write(dir.join("both.txt"), both).unwrap();
     let one = run_json(
         bin()
-            .args(["calibrate", "multi-position", "--json", "--gravity", "9.81744"])
+            .args([
+                "calibrate",
+                "multi-position",
+                "--json",
+                "--gravity",
+                "9.81744",
+            ])
             .args(["--gyro-scale-guess", "1.598e-4"])
             .arg(dir.join("both.txt")),
     );

@@ -326,7 +326,7 @@ fn covariance_coverage_over_seeds() {
             }
         }
         eprintln!(
-            "{} with bias instability and RRW on (not asserted): within 1.96σ {:.1} % of \
+            "{} with bias instability and RRW on: within 1.96σ {:.1} % of \
              the turn-on truth, {:.1} % of the bias in effect during the run",
             preset.name(),
             100.0 * f196 as f64 / nf as f64,
