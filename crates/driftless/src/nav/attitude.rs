@@ -49,12 +49,17 @@ impl Quat {
     pub fn from_rotation_vector(phi: Vec3) -> Quat {
         let a2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
         let a = a2.sqrt();
-        // sin(a/2)/a by series for small angles (keeps full precision for increments
-        // of 1e-8 rad and below).
-        let (c, s) = if a < 1e-4 {
+        // cos(a/2) and sin(a/2)/a by their Taylor series for small angles (every IMU
+        // increment and every filter correction): terms to a⁸, so the first omitted term
+        // is below 3e-23 for a < 0.05 rad — exact to rounding, and no libm call.
+        let (c, s) = if a < 0.05 {
             (
-                1.0 - a2 / 8.0 + a2 * a2 / 384.0,
-                0.5 - a2 / 48.0 + a2 * a2 / 3840.0,
+                1.0 + a2
+                    * (-1.0 / 8.0
+                        + a2 * (1.0 / 384.0 + a2 * (-1.0 / 46_080.0 + a2 / 10_321_920.0))),
+                0.5 + a2
+                    * (-1.0 / 48.0
+                        + a2 * (1.0 / 3840.0 + a2 * (-1.0 / 645_120.0 + a2 / 185_794_560.0))),
             )
         } else {
             ((a / 2.0).cos(), (a / 2.0).sin() / a)
@@ -303,5 +308,20 @@ mod tests {
         let a = [0.01, 0.02, -0.005];
         let b = [0.02, 0.04, -0.01];
         assert_eq!(coning_rotation_vector(a, b), b);
+    }
+}
+
+#[cfg(test)]
+mod rotation_series_tests {
+    use super::Quat;
+
+    #[test]
+    fn series_matches_sin_cos_up_to_the_switch() {
+        for a in [1e-9, 1e-6, 1e-4, 1e-3, 0.01, 0.03, 0.0499] {
+            let q = Quat::from_rotation_vector([a * 0.6, -a * 0.8, 0.0]);
+            let (c, s) = ((a / 2.0_f64).cos(), (a / 2.0_f64).sin() / a);
+            assert!((q.0[0] - c).abs() <= 2e-16, "a {a}: cos");
+            assert!((q.0[1] - 0.6 * a * s).abs() <= 2e-16 * a, "a {a}: sin");
+        }
     }
 }
