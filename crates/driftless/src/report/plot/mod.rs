@@ -38,8 +38,8 @@ use std::path::Path;
 
 pub use error::PlotError;
 pub use figure::{
-    Annotation, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, Line, LineStyle, LogLogPlot,
-    MARKER_CYCLE, MarkerShape, PALETTE, Series,
+    Annotation, AxisScale, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, Line, LineStyle,
+    LogLogPlot, MARKER_CYCLE, MarkerShape, PALETTE, Plot, Series,
 };
 pub use svg::xml_escape;
 pub use text::text_width;
