@@ -107,6 +107,10 @@ pub struct Series {
     pub marker: Option<MarkerShape>,
     /// Join consecutive valid points with a thin line.
     pub connect: bool,
+    /// Draw the CI (`y_lo`, `y_hi`) as a translucent shaded band between
+    /// consecutive valid points instead of error bars (e.g. the confidence
+    /// band of a fitted curve).
+    pub band: bool,
 }
 
 impl Series {
@@ -126,6 +130,13 @@ impl Series {
         self.y_lo = Some(y_lo);
         self.y_hi = Some(y_hi);
         self
+    }
+
+    /// Adds a confidence band: like [`with_ci`](Self::with_ci), drawn as a
+    /// shaded area rather than error bars.
+    pub fn with_band(mut self, y_lo: Vec<f64>, y_hi: Vec<f64>) -> Self {
+        self.band = true;
+        self.with_ci(y_lo, y_hi)
     }
 
     pub fn with_color(mut self, color: Color) -> Self {

@@ -2,9 +2,9 @@
 
 use super::figure::{
     AxisScale, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, LineStyle, MARKER_CYCLE,
-    MarkerShape, PALETTE, Plot,
+    MarkerShape, PALETTE, Plot, Series,
 };
-use super::geom::{Pt, Rect, clip_polyline, clip_segment, segment_hits_rect};
+use super::geom::{Pt, Rect, clip_polygon, clip_polyline, clip_segment, segment_hits_rect};
 use super::scale::{
     AxisMap, Tick, explicit_linear_range, explicit_range, linear_extent, linear_padded_range,
     linear_ticks, log_extent, log_ticks, padded_range,
@@ -28,6 +28,8 @@ const LEGEND_BORDER: Color = Color::rgb(0xb0, 0xb0, 0xb0);
 const MAJOR_TICK: f64 = 5.0;
 const MINOR_TICK: f64 = 3.0;
 const MARKER_R: f64 = 3.6;
+/// Fill opacity of a series' confidence band.
+const BAND_OPACITY: f64 = 0.18;
 /// Upper bound on obstacle primitives considered by label placement, so huge
 /// series do not make layout quadratic.
 const MAX_OBSTACLES: usize = 4000;
@@ -389,6 +391,9 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
         let color = s.color.unwrap_or(PALETTE[si % PALETTE.len()]);
         let shape = s.marker.unwrap_or(MARKER_CYCLE[si % MARKER_CYCLE.len()]);
         let pts: Vec<Option<Pt>> = s.x.iter().zip(&s.y).map(|(&x, &y)| map(x, y)).collect();
+        if s.band {
+            push_band(s, &xm, &ym, &area, color, items);
+        }
         if s.connect {
             let runs = clip_polyline(&pts, &area);
             for r in &runs {
@@ -402,7 +407,7 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
             }
             obstacles.add_runs(&runs);
         }
-        if s.y_lo.is_some() || s.y_hi.is_some() {
+        if !s.band && (s.y_lo.is_some() || s.y_hi.is_some()) {
             for (i, p) in pts.iter().enumerate() {
                 let Some(p) = *p else { continue };
                 let log_y = plot.y_scale == AxisScale::Log;
@@ -467,6 +472,7 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
                 sample: Sample::Series {
                     shape,
                     connect: s.connect,
+                    band: s.band && s.y_lo.is_some() && s.y_hi.is_some(),
                 },
             });
         }
@@ -606,6 +612,54 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
     }
 }
 
+/// The shaded CI band of a series: one polygon per run of consecutive points
+/// whose x, `y_lo` and `y_hi` are all shown by the axes, clipped to `area`.
+fn push_band(
+    s: &Series,
+    xm: &AxisMap,
+    ym: &AxisMap,
+    area: &Rect,
+    color: Color,
+    items: &mut Vec<Prim>,
+) {
+    let (Some(lo), Some(hi)) = (&s.y_lo, &s.y_hi) else {
+        return;
+    };
+    let mut runs: Vec<Vec<(f64, f64, f64)>> = vec![Vec::new()];
+    for ((&x, &l), &h) in s.x.iter().zip(lo).zip(hi) {
+        // Far-off vertices are pulled in so the clip arithmetic stays finite.
+        let (bx, by) = (
+            area.x - 1e7..=area.right() + 1e7,
+            area.y - 1e7..=area.bottom() + 1e7,
+        );
+        let cx = |v: f64| v.clamp(*bx.start(), *bx.end());
+        let cy = |v: f64| v.clamp(*by.start(), *by.end());
+        match (xm.px(x), ym.px(l), ym.px(h)) {
+            (Some(px), Some(pl), Some(ph)) if !(px + pl + ph).is_nan() => {
+                if let Some(r) = runs.last_mut() {
+                    r.push((cx(px), cy(pl), cy(ph)));
+                }
+            }
+            _ => runs.push(Vec::new()),
+        }
+    }
+    for run in runs.iter().filter(|r| r.len() >= 2) {
+        let poly: Vec<Pt> = run
+            .iter()
+            .map(|&(x, _, h)| (x, h))
+            .chain(run.iter().rev().map(|&(x, l, _)| (x, l)))
+            .collect();
+        let poly = clip_polygon(&poly, area);
+        if !poly.is_empty() {
+            items.push(Prim::Polygon {
+                pts: poly,
+                color,
+                opacity: BAND_OPACITY,
+            });
+        }
+    }
+}
+
 fn grid_line(a: Pt, b: Pt, color: Color) -> Prim {
     Prim::Path {
         pts: vec![a, b],
@@ -717,8 +771,14 @@ fn place_label(
 }
 
 enum Sample {
-    Series { shape: MarkerShape, connect: bool },
-    Line { dash: Dash },
+    Series {
+        shape: MarkerShape,
+        connect: bool,
+        band: bool,
+    },
+    Line {
+        dash: Dash,
+    },
 }
 
 struct LegendEntry {
@@ -790,7 +850,21 @@ fn draw_legend(
         let x0 = rect.x + LEGEND_PAD;
         let mid = (x0 + LEGEND_SAMPLE / 2.0, cy);
         match e.sample {
-            Sample::Series { shape, connect } => {
+            Sample::Series {
+                shape,
+                connect,
+                band,
+            } => {
+                if band {
+                    items.push(Prim::Rect {
+                        x: x0,
+                        y: cy - 5.0,
+                        w: LEGEND_SAMPLE,
+                        h: 10.0,
+                        fill: Some((e.color, BAND_OPACITY)),
+                        stroke: None,
+                    });
+                }
                 if connect {
                     items.push(Prim::Path {
                         pts: vec![(x0, cy), (x0 + LEGEND_SAMPLE, cy)],

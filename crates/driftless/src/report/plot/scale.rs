@@ -271,19 +271,24 @@ pub fn explicit_linear_range(range: (f64, f64)) -> Option<(f64, f64)> {
     Some(widen_degenerate(a.min(b), a.max(b)))
 }
 
-/// The "nice" step `m·10^k` (`m` ∈ {1, 2, 5}) for at most `max_ticks` major
-/// ticks on a span, as `(step, m, k)`; `None` if the span is unusable.
-fn nice_step(span: f64, max_ticks: f64) -> Option<(f64, u32, i32)> {
+/// The smallest "nice" step `m·10^k` (`m` ∈ {1, 2, 5}) giving at most
+/// `max_ticks` multiples of the step inside `[lo, hi]`, as `(step, m, k)`;
+/// `None` if the range is unusable.
+fn nice_step(lo: f64, hi: f64, max_ticks: f64) -> Option<(f64, u32, i32)> {
+    let span = hi - lo;
     if !(span.is_finite() && span > 0.0) {
         return None;
     }
-    // `max_ticks` ticks cover `max_ticks - 1` intervals (plus rounding).
-    let raw = span / (max_ticks - 1.0).max(1.0);
-    let mut k = raw.log10().floor() as i32 - 1;
-    for _ in 0..4 {
+    let eps = 1e-9 * span;
+    let mut k = (span / max_ticks).log10().floor() as i32 - 1;
+    for _ in 0..5 {
         for m in [1u32, 2, 5] {
             let step = f64::from(m) * 10f64.powi(k);
-            if step.is_finite() && step > 0.0 && step >= raw * (1.0 - 1e-9) {
+            if !(step.is_finite() && step > 0.0) {
+                continue;
+            }
+            let count = ((hi + eps) / step).floor() - ((lo - eps) / step).ceil() + 1.0;
+            if count <= max_ticks {
                 return Some((step, m, k));
             }
         }
@@ -354,7 +359,7 @@ pub fn linear_ticks(lo: f64, hi: f64, length_px: f64, min_label_gap_px: f64) -> 
         1.0
     };
     let max_ticks = (length_px / gap + 1.0).floor().clamp(2.0, MAX_LINEAR_TICKS);
-    let Some((step, m, k)) = nice_step(span, max_ticks) else {
+    let Some((step, m, k)) = nice_step(lo, hi, max_ticks) else {
         return ticks;
     };
     let eps = 1e-9 * span;
