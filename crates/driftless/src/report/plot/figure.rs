@@ -88,8 +88,9 @@ pub enum LineStyle {
 /// Measured points: markers, an optional thin connecting line and optional
 /// confidence-interval error bars (`y_lo[i] ..= y_hi[i]` at `x[i]`).
 ///
-/// Points whose coordinates are not finite and positive are skipped (log axes);
-/// if the vectors differ in length the extra elements are ignored.
+/// Points that an axis cannot show are skipped (not finite, or not positive
+/// on a log axis); if the vectors differ in length the extra elements are
+/// ignored. On a linear y axis the CI bounds may be negative.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Series {
     /// Legend entry; an empty name keeps the series out of the legend.
@@ -106,6 +107,10 @@ pub struct Series {
     pub marker: Option<MarkerShape>,
     /// Join consecutive valid points with a thin line.
     pub connect: bool,
+    /// Draw the CI (`y_lo`, `y_hi`) as a translucent shaded band between
+    /// consecutive valid points instead of error bars (e.g. the confidence
+    /// band of a fitted curve).
+    pub band: bool,
 }
 
 impl Series {
@@ -125,6 +130,13 @@ impl Series {
         self.y_lo = Some(y_lo);
         self.y_hi = Some(y_hi);
         self
+    }
+
+    /// Adds a confidence band: like [`with_ci`](Self::with_ci), drawn as a
+    /// shaded area rather than error bars.
+    pub fn with_band(mut self, y_lo: Vec<f64>, y_hi: Vec<f64>) -> Self {
+        self.band = true;
+        self.with_ci(y_lo, y_hi)
     }
 
     pub fn with_color(mut self, color: Color) -> Self {
@@ -268,9 +280,25 @@ pub enum LegendPosition {
     Hidden,
 }
 
-/// One log-log panel.
+/// How an axis maps data onto the page.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum AxisScale {
+    /// Log₁₀ axis with decade ticks; only finite positive values are shown.
+    #[default]
+    Log,
+    /// Linear axis with 1-2-5 × 10ᵏ ticks; any finite value is shown
+    /// (negatives and zero included).
+    Linear,
+}
+
+/// The historical name of [`Plot`] (log-log is still the default).
+pub type LogLogPlot = Plot;
+
+/// One panel: log-log by default (Allan deviation), either axis can be
+/// switched to linear with [`Plot::linear_x`] / [`Plot::linear_y`] or
+/// created linear-linear with [`Plot::linear`].
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct LogLogPlot {
+pub struct Plot {
     pub title: String,
     /// Axis title including the unit, e.g. `"τ (s)"`.
     pub x_label: String,
@@ -285,20 +313,65 @@ pub struct LogLogPlot {
     /// Fixed y range (data units), as `x_range`.
     pub y_range: Option<(f64, f64)>,
     pub legend: LegendPosition,
+    /// Scale of the x axis (default [`AxisScale::Log`]).
+    pub x_scale: AxisScale,
+    /// Scale of the y axis (default [`AxisScale::Log`]).
+    pub y_scale: AxisScale,
 }
 
-impl LogLogPlot {
+impl Plot {
+    /// A log-log panel.
     pub fn new(
         title: impl Into<String>,
         x_label: impl Into<String>,
         y_label: impl Into<String>,
     ) -> Self {
-        LogLogPlot {
+        Plot {
             title: title.into(),
             x_label: x_label.into(),
             y_label: y_label.into(),
             ..Default::default()
         }
+    }
+
+    /// A panel with both axes linear (e.g. bias vs temperature).
+    pub fn linear(
+        title: impl Into<String>,
+        x_label: impl Into<String>,
+        y_label: impl Into<String>,
+    ) -> Self {
+        Plot::new(title, x_label, y_label).linear_x().linear_y()
+    }
+
+    /// Makes the x axis linear.
+    pub fn linear_x(mut self) -> Self {
+        self.x_scale = AxisScale::Linear;
+        self
+    }
+
+    /// Makes the y axis linear.
+    pub fn linear_y(mut self) -> Self {
+        self.y_scale = AxisScale::Linear;
+        self
+    }
+
+    /// Sets both axis scales.
+    pub fn with_scales(mut self, x: AxisScale, y: AxisScale) -> Self {
+        self.x_scale = x;
+        self.y_scale = y;
+        self
+    }
+
+    /// Fixes the x range (data units).
+    pub fn with_x_range(mut self, min: f64, max: f64) -> Self {
+        self.x_range = Some((min, max));
+        self
+    }
+
+    /// Fixes the y range (data units).
+    pub fn with_y_range(mut self, min: f64, max: f64) -> Self {
+        self.y_range = Some((min, max));
+        self
     }
 
     pub fn with_series(mut self, series: Series) -> Self {
@@ -327,7 +400,7 @@ pub const DEFAULT_PANEL_SIZE: (f64, f64) = (640.0, 480.0);
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure {
     pub title: Option<String>,
-    pub panels: Vec<LogLogPlot>,
+    pub panels: Vec<Plot>,
     /// Panels per row; `0` means all in one row.
     pub columns: usize,
     /// Size of each panel cell in px.
@@ -348,7 +421,7 @@ impl Default for Figure {
 }
 
 impl Figure {
-    pub fn single(plot: LogLogPlot) -> Self {
+    pub fn single(plot: Plot) -> Self {
         Figure {
             panels: vec![plot],
             ..Default::default()
@@ -356,7 +429,7 @@ impl Figure {
     }
 
     /// Panels laid out row-major, `columns` per row (`0`: one row).
-    pub fn grid(panels: Vec<LogLogPlot>, columns: usize) -> Self {
+    pub fn grid(panels: Vec<Plot>, columns: usize) -> Self {
         Figure {
             panels,
             columns,

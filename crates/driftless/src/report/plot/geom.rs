@@ -120,3 +120,60 @@ pub(crate) fn clip_polyline(pts: &[Option<Pt>], r: &Rect) -> Vec<Vec<Pt>> {
 pub(crate) fn segment_hits_rect(a: Pt, b: Pt, r: &Rect) -> bool {
     clip_segment(a, b, r).is_some()
 }
+
+/// Sutherland–Hodgman clip of a closed polygon to `r` (empty if nothing of
+/// it is inside). Vertices must be finite.
+pub(crate) fn clip_polygon(pts: &[Pt], r: &Rect) -> Vec<Pt> {
+    // Each edge: (is the point inside, intersection of a→b with the edge).
+    fn clip_edge(poly: &[Pt], inside: impl Fn(Pt) -> bool, cut: impl Fn(Pt, Pt) -> Pt) -> Vec<Pt> {
+        let mut out = Vec::with_capacity(poly.len() + 2);
+        for (i, &b) in poly.iter().enumerate() {
+            let a = poly[(i + poly.len() - 1) % poly.len()];
+            match (inside(a), inside(b)) {
+                (true, true) => out.push(b),
+                (true, false) => out.push(cut(a, b)),
+                (false, true) => {
+                    out.push(cut(a, b));
+                    out.push(b);
+                }
+                (false, false) => {}
+            }
+        }
+        out
+    }
+    let at_x = |a: Pt, b: Pt, x: f64| {
+        let t = if b.0 == a.0 {
+            0.0
+        } else {
+            (x - a.0) / (b.0 - a.0)
+        };
+        (x, a.1 + t * (b.1 - a.1))
+    };
+    let at_y = |a: Pt, b: Pt, y: f64| {
+        let t = if b.1 == a.1 {
+            0.0
+        } else {
+            (y - a.1) / (b.1 - a.1)
+        };
+        (a.0 + t * (b.0 - a.0), y)
+    };
+    let (x0, x1, y0, y1) = (r.x, r.right(), r.y, r.bottom());
+    let mut poly = pts.to_vec();
+    if poly.len() < 3 {
+        return Vec::new();
+    }
+    poly = clip_edge(&poly, |p| p.0 >= x0, |a, b| at_x(a, b, x0));
+    if poly.is_empty() {
+        return poly;
+    }
+    poly = clip_edge(&poly, |p| p.0 <= x1, |a, b| at_x(a, b, x1));
+    if poly.is_empty() {
+        return poly;
+    }
+    poly = clip_edge(&poly, |p| p.1 >= y0, |a, b| at_y(a, b, y0));
+    if poly.is_empty() {
+        return poly;
+    }
+    poly = clip_edge(&poly, |p| p.1 <= y1, |a, b| at_y(a, b, y1));
+    if poly.len() < 3 { Vec::new() } else { poly }
+}

@@ -1,11 +1,14 @@
 //! Figure → [`Scene`]: margins, axes, ticks, data, legend and label placement.
 
 use super::figure::{
-    Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, LineStyle, LogLogPlot, MARKER_CYCLE,
-    MarkerShape, PALETTE,
+    AxisScale, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, LineStyle, MARKER_CYCLE,
+    MarkerShape, PALETTE, Plot, Series,
 };
-use super::geom::{Pt, Rect, clip_polyline, clip_segment, segment_hits_rect};
-use super::scale::{LogMap, Tick, explicit_range, log_extent, log_ticks, padded_range};
+use super::geom::{Pt, Rect, clip_polygon, clip_polyline, clip_segment, segment_hits_rect};
+use super::scale::{
+    AxisMap, Tick, explicit_linear_range, explicit_range, linear_extent, linear_padded_range,
+    linear_ticks, log_extent, log_ticks, padded_range,
+};
 use super::scene::{Anchor, Dash, Prim, Scene};
 use super::text::{CAP_HEIGHT_EM, DESCENT_EM, text_width};
 
@@ -25,6 +28,8 @@ const LEGEND_BORDER: Color = Color::rgb(0xb0, 0xb0, 0xb0);
 const MAJOR_TICK: f64 = 5.0;
 const MINOR_TICK: f64 = 3.0;
 const MARKER_R: f64 = 3.6;
+/// Fill opacity of a series' confidence band.
+const BAND_OPACITY: f64 = 0.18;
 /// Upper bound on obstacle primitives considered by label placement, so huge
 /// series do not make layout quadratic.
 const MAX_OBSTACLES: usize = 4000;
@@ -126,17 +131,24 @@ fn fit_text(s: &str, size: f64, max_w: f64) -> String {
     out
 }
 
-fn valid(v: f64) -> bool {
-    v.is_finite() && v > 0.0
+/// Whether an axis of this scale can show `v`.
+fn valid(scale: AxisScale, v: f64) -> bool {
+    match scale {
+        AxisScale::Log => v.is_finite() && v > 0.0,
+        AxisScale::Linear => v.is_finite(),
+    }
 }
 
-/// Displayed log ranges `(x, y)` of a panel.
-fn panel_ranges(plot: &LogLogPlot) -> ((f64, f64), (f64, f64)) {
+/// Displayed ranges `(x, y)` of a panel, in axis coordinates (log10 units on
+/// a log axis, data units on a linear one).
+fn panel_ranges(plot: &Plot) -> ((f64, f64), (f64, f64)) {
+    let vx = |v| valid(plot.x_scale, v);
+    let vy = |v| valid(plot.y_scale, v);
     let mut xs = Vec::new();
     let mut ys = Vec::new();
     for s in &plot.series {
         for (i, (&x, &y)) in s.x.iter().zip(&s.y).enumerate() {
-            if valid(x) && valid(y) {
+            if vx(x) && vy(y) {
                 xs.push(x);
                 ys.push(y);
                 for b in [&s.y_lo, &s.y_hi].into_iter().flatten() {
@@ -150,20 +162,27 @@ fn panel_ranges(plot: &LogLogPlot) -> ((f64, f64), (f64, f64)) {
     if xs.is_empty() {
         for l in &plot.lines {
             for (&x, &y) in l.x.iter().zip(&l.y) {
-                if valid(x) && valid(y) {
+                if vx(x) && vy(y) {
                     xs.push(x);
                     ys.push(y);
                 }
             }
         }
     }
-    let fit = |explicit: Option<(f64, f64)>, vals: Vec<f64>| {
-        explicit
+    let fit = |scale: AxisScale, explicit: Option<(f64, f64)>, vals: Vec<f64>| match scale {
+        AxisScale::Log => explicit
             .and_then(explicit_range)
             .or_else(|| log_extent(vals).map(|(a, b)| padded_range(a, b)))
-            .unwrap_or((0.0, 1.0))
+            .unwrap_or((0.0, 1.0)),
+        AxisScale::Linear => explicit
+            .and_then(explicit_linear_range)
+            .or_else(|| linear_extent(vals).map(|(a, b)| linear_padded_range(a, b)))
+            .unwrap_or((0.0, 1.0)),
     };
-    (fit(plot.x_range, xs), fit(plot.y_range, ys))
+    (
+        fit(plot.x_scale, plot.x_range, xs),
+        fit(plot.y_scale, plot.y_range, ys),
+    )
 }
 
 /// Things that labels and the legend should not cover.
@@ -234,9 +253,13 @@ fn dash_of(style: LineStyle) -> Dash {
 }
 
 /// Ticks for an axis, with the label gap widened until labels fit.
-fn axis_ticks(range: (f64, f64), len: f64, horizontal: bool) -> Vec<Tick> {
+fn axis_ticks(scale: AxisScale, range: (f64, f64), len: f64, horizontal: bool) -> Vec<Tick> {
+    let ticks_fn = match scale {
+        AxisScale::Log => log_ticks,
+        AxisScale::Linear => linear_ticks,
+    };
     let min_gap = if horizontal { 40.0 } else { TICK_SIZE * 1.8 };
-    let mut ticks = log_ticks(range.0, range.1, len, min_gap);
+    let mut ticks = ticks_fn(range.0, range.1, len, min_gap);
     if horizontal {
         let widest = ticks
             .iter()
@@ -244,13 +267,13 @@ fn axis_ticks(range: (f64, f64), len: f64, horizontal: bool) -> Vec<Tick> {
             .map(|l| text_width(l, TICK_SIZE))
             .fold(0.0, f64::max);
         if widest + 12.0 > min_gap {
-            ticks = log_ticks(range.0, range.1, len, widest + 12.0);
+            ticks = ticks_fn(range.0, range.1, len, widest + 12.0);
         }
     }
     ticks
 }
 
-fn layout_panel(plot: &LogLogPlot, cell: Rect, items: &mut Vec<Prim>) {
+fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
     let title = plot.title.trim();
     let x_title = plot.x_label.trim();
     let y_title = plot.y_label.trim();
@@ -273,7 +296,7 @@ fn layout_panel(plot: &LogLogPlot, cell: Rect, items: &mut Vec<Prim>) {
     let plot_h = bottom - top;
 
     let (xr, yr) = panel_ranges(plot);
-    let y_ticks = axis_ticks(yr, plot_h, false);
+    let y_ticks = axis_ticks(plot.y_scale, yr, plot_h, false);
     let ytick_w = y_ticks
         .iter()
         .filter_map(|t| t.label.as_deref())
@@ -287,16 +310,18 @@ fn layout_panel(plot: &LogLogPlot, cell: Rect, items: &mut Vec<Prim>) {
     };
     let right = (cell.right() - 24.0).max(left + 20.0);
     let plot_w = right - left;
-    let x_ticks = axis_ticks(xr, plot_w, true);
+    let x_ticks = axis_ticks(plot.x_scale, xr, plot_w, true);
 
     let area = Rect::new(left, top, plot_w, plot_h);
-    let xm = LogMap {
+    let xm = AxisMap {
+        scale: plot.x_scale,
         lo: xr.0,
         hi: xr.1,
         p0: left,
         p1: right,
     };
-    let ym = LogMap {
+    let ym = AxisMap {
+        scale: plot.y_scale,
         lo: yr.0,
         hi: yr.1,
         p0: bottom,
@@ -366,6 +391,9 @@ fn layout_panel(plot: &LogLogPlot, cell: Rect, items: &mut Vec<Prim>) {
         let color = s.color.unwrap_or(PALETTE[si % PALETTE.len()]);
         let shape = s.marker.unwrap_or(MARKER_CYCLE[si % MARKER_CYCLE.len()]);
         let pts: Vec<Option<Pt>> = s.x.iter().zip(&s.y).map(|(&x, &y)| map(x, y)).collect();
+        if s.band {
+            push_band(s, &xm, &ym, &area, color, items);
+        }
         if s.connect {
             let runs = clip_polyline(&pts, &area);
             for r in &runs {
@@ -379,13 +407,15 @@ fn layout_panel(plot: &LogLogPlot, cell: Rect, items: &mut Vec<Prim>) {
             }
             obstacles.add_runs(&runs);
         }
-        if s.y_lo.is_some() || s.y_hi.is_some() {
+        if !s.band && (s.y_lo.is_some() || s.y_hi.is_some()) {
             for (i, p) in pts.iter().enumerate() {
                 let Some(p) = *p else { continue };
+                let log_y = plot.y_scale == AxisScale::Log;
                 let end = |b: &Option<Vec<f64>>, beyond: f64| -> f64 {
                     match b.as_ref().and_then(|v| v.get(i)).copied() {
-                        Some(v) if valid(v) => ym.px(v).unwrap_or(p.1),
-                        Some(v) if v <= 0.0 => beyond, // −∞ on a log axis
+                        Some(v) if ym.accepts(v) => ym.px(v).unwrap_or(p.1),
+                        Some(v) if log_y && v <= 0.0 => beyond, // −∞ on a log axis
+                        Some(v) if v == f64::NEG_INFINITY => area.bottom() + 1.0,
                         Some(v) if v == f64::INFINITY => area.y - 1.0,
                         _ => p.1,
                     }
@@ -442,6 +472,7 @@ fn layout_panel(plot: &LogLogPlot, cell: Rect, items: &mut Vec<Prim>) {
                 sample: Sample::Series {
                     shape,
                     connect: s.connect,
+                    band: s.band && s.y_lo.is_some() && s.y_hi.is_some(),
                 },
             });
         }
@@ -581,6 +612,54 @@ fn layout_panel(plot: &LogLogPlot, cell: Rect, items: &mut Vec<Prim>) {
     }
 }
 
+/// The shaded CI band of a series: one polygon per run of consecutive points
+/// whose x, `y_lo` and `y_hi` are all shown by the axes, clipped to `area`.
+fn push_band(
+    s: &Series,
+    xm: &AxisMap,
+    ym: &AxisMap,
+    area: &Rect,
+    color: Color,
+    items: &mut Vec<Prim>,
+) {
+    let (Some(lo), Some(hi)) = (&s.y_lo, &s.y_hi) else {
+        return;
+    };
+    let mut runs: Vec<Vec<(f64, f64, f64)>> = vec![Vec::new()];
+    for ((&x, &l), &h) in s.x.iter().zip(lo).zip(hi) {
+        // Far-off vertices are pulled in so the clip arithmetic stays finite.
+        let (bx, by) = (
+            area.x - 1e7..=area.right() + 1e7,
+            area.y - 1e7..=area.bottom() + 1e7,
+        );
+        let cx = |v: f64| v.clamp(*bx.start(), *bx.end());
+        let cy = |v: f64| v.clamp(*by.start(), *by.end());
+        match (xm.px(x), ym.px(l), ym.px(h)) {
+            (Some(px), Some(pl), Some(ph)) if !(px + pl + ph).is_nan() => {
+                if let Some(r) = runs.last_mut() {
+                    r.push((cx(px), cy(pl), cy(ph)));
+                }
+            }
+            _ => runs.push(Vec::new()),
+        }
+    }
+    for run in runs.iter().filter(|r| r.len() >= 2) {
+        let poly: Vec<Pt> = run
+            .iter()
+            .map(|&(x, _, h)| (x, h))
+            .chain(run.iter().rev().map(|&(x, l, _)| (x, l)))
+            .collect();
+        let poly = clip_polygon(&poly, area);
+        if !poly.is_empty() {
+            items.push(Prim::Polygon {
+                pts: poly,
+                color,
+                opacity: BAND_OPACITY,
+            });
+        }
+    }
+}
+
 fn grid_line(a: Pt, b: Pt, color: Color) -> Prim {
     Prim::Path {
         pts: vec![a, b],
@@ -692,8 +771,14 @@ fn place_label(
 }
 
 enum Sample {
-    Series { shape: MarkerShape, connect: bool },
-    Line { dash: Dash },
+    Series {
+        shape: MarkerShape,
+        connect: bool,
+        band: bool,
+    },
+    Line {
+        dash: Dash,
+    },
 }
 
 struct LegendEntry {
@@ -765,7 +850,21 @@ fn draw_legend(
         let x0 = rect.x + LEGEND_PAD;
         let mid = (x0 + LEGEND_SAMPLE / 2.0, cy);
         match e.sample {
-            Sample::Series { shape, connect } => {
+            Sample::Series {
+                shape,
+                connect,
+                band,
+            } => {
+                if band {
+                    items.push(Prim::Rect {
+                        x: x0,
+                        y: cy - 5.0,
+                        w: LEGEND_SAMPLE,
+                        h: 10.0,
+                        fill: Some((e.color, BAND_OPACITY)),
+                        stroke: None,
+                    });
+                }
                 if connect {
                     items.push(Prim::Path {
                         pts: vec![(x0, cy), (x0 + LEGEND_SAMPLE, cy)],

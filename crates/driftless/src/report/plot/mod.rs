@@ -1,27 +1,47 @@
-//! Log-log plots (Allan-deviation style) rendered to SVG, and to PNG with the
-//! `png` feature.
+//! Report plots — log-log (Allan deviation) and linear or semi-log
+//! (calibration residuals, bias vs temperature) — rendered to SVG, and to PNG
+//! with the `png` feature.
 //!
-//! The input types ([`Figure`], [`LogLogPlot`], [`Series`], [`Line`],
-//! [`Annotation`]) are plain data, independent of the Allan types. A figure is
-//! laid out once into a display list which both back-ends draw, so the SVG
-//! and the PNG show the same picture.
+//! The input types ([`Figure`], [`Plot`] (alias [`LogLogPlot`]), [`Series`],
+//! [`Line`], [`Annotation`]) are plain data, independent of the Allan types.
+//! A figure is laid out once into a display list which both back-ends draw,
+//! so the SVG and the PNG show the same picture.
+//!
+//! Each panel axis is [`AxisScale::Log`] (the default: decade ticks, labels
+//! like `10⁻²`) or [`AxisScale::Linear`] (1-2-5 × 10ᵏ ticks, 2–8 labels with
+//! one precision per axis: `-0.5`, `0`, `2.5`, or `1.05e-3` / `-1.0e6` for
+//! tiny and huge values); see [`scale`].
 //!
 //! ```
-//! use driftless::report::plot::{Figure, Line, LogLogPlot, Series, render_svg};
+//! use driftless::report::plot::{Figure, Line, LogLogPlot, Plot, Series, render_svg};
+//! // Allan deviation: log-log.
 //! let taus = vec![0.01, 0.1, 1.0, 10.0, 100.0];
 //! let adev = vec![0.3, 0.1, 0.04, 0.035, 0.05];
-//! let plot = LogLogPlot::new("Gyro", "τ (s)", "σ(τ) (deg/s)")
+//! let allan = LogLogPlot::new("Gyro", "τ (s)", "σ(τ) (deg/s)")
 //!     .with_series(Series::new("X", taus.clone(), adev))
 //!     .with_line(Line::power_law("white noise", 0.03, -0.5, 0.01, 100.0, 2)
 //!         .dashed()
 //!         .with_label("N = 0.03 deg/√s"));
-//! let svg = render_svg(&Figure::single(plot));
+//! // Bias vs temperature: linear axes, negative values, a fitted curve with
+//! // a shaded confidence band.
+//! let t = vec![-20.0, 0.0, 20.0, 40.0];
+//! let fit: Vec<f64> = t.iter().map(|x| -0.5 + 0.02 * x).collect();
+//! let thermal = Plot::linear("Bias vs T", "T (°C)", "bias (deg/s)")
+//!     .with_series(
+//!         Series::new("fit ± 2σ", t.clone(), fit.clone())
+//!             .with_band(fit.iter().map(|y| y - 0.1).collect(),
+//!                        fit.iter().map(|y| y + 0.1).collect()),
+//!     )
+//!     .with_series(Series::new("bias", t, vec![-0.9, -0.45, -0.12, 0.33]).connected(false));
+//! let svg = render_svg(&Figure::grid(vec![allan, thermal], 2));
 //! assert!(svg.starts_with("<svg"));
+//! assert!(svg.contains(">-0.4<") && svg.contains(">0<")); // linear tick labels
 //! ```
 //!
-//! Robustness: values that a log axis cannot show (NaN, ±∞, zero, negative)
-//! are skipped and break connecting lines; empty series, a single point and
-//! ranges of hundreds of decades all render. Nothing here panics on data.
+//! Robustness: values that an axis cannot show (NaN and ±∞ everywhere; zero
+//! and negatives on a log axis) are skipped and break connecting lines and
+//! bands; empty series, a single point, constant data and ranges of hundreds
+//! of decades all render. Nothing here panics on data.
 
 mod error;
 mod figure;
@@ -38,8 +58,8 @@ use std::path::Path;
 
 pub use error::PlotError;
 pub use figure::{
-    Annotation, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, Line, LineStyle, LogLogPlot,
-    MARKER_CYCLE, MarkerShape, PALETTE, Series,
+    Annotation, AxisScale, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, Line, LineStyle,
+    LogLogPlot, MARKER_CYCLE, MarkerShape, PALETTE, Plot, Series,
 };
 pub use svg::xml_escape;
 pub use text::text_width;

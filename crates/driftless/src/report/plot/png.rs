@@ -153,6 +153,17 @@ impl Raster<'_> {
                     self.stroke(&path, *color, *opacity, *width, *dash);
                 }
             }
+            Prim::Polygon {
+                pts,
+                color,
+                opacity,
+            } => {
+                if pts.len() >= 3
+                    && let Some(path) = polyline(pts, true)
+                {
+                    self.fill(&path, *color, *opacity);
+                }
+            }
             Prim::Marker {
                 at,
                 shape,

@@ -1,15 +1,20 @@
-//! Log₁₀ axis maths: range fitting, decade / minor ticks and tick labels.
+//! Axis maths: range fitting, ticks and tick labels for log₁₀ axes
+//! ([`log_ticks`]) and linear axes ([`linear_ticks`]).
 
-/// A tick on a log axis.
+use super::figure::AxisScale;
+
+/// A tick on an axis.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Tick {
     /// Position in data units.
     pub value: f64,
-    /// `log10(value)`.
+    /// Axis coordinate: `log10(value)` on a log axis, `value` itself on a
+    /// linear axis.
     pub log: f64,
-    /// Decade tick (gets a gridline and, normally, a label).
+    /// Major tick: a decade on a log axis, a labelled step on a linear one
+    /// (gets a gridline and, normally, a label).
     pub major: bool,
-    /// Text under / beside the tick, e.g. `"10⁻²"`.
+    /// Text under / beside the tick, e.g. `"10⁻²"` or `"-0.5"`.
     pub label: Option<String>,
 }
 
@@ -197,21 +202,251 @@ fn nice_stride(need: f64) -> i32 {
     }
 }
 
-/// Linear map from a log range onto pixels.
+/// Largest magnitude a linear axis shows; data beyond it is clamped for range
+/// fitting (so spans and steps stay finite).
+const LINEAR_LIMIT: f64 = 1e300;
+/// Most major ticks on a linear axis.
+const MAX_LINEAR_TICKS: f64 = 8.0;
+
+/// `(min, max)` of the finite values (clamped to ±10³⁰⁰); `None` when there
+/// are none.
+pub fn linear_extent(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
+    let mut ext: Option<(f64, f64)> = None;
+    for v in values {
+        if v.is_finite() {
+            let v = v.clamp(-LINEAR_LIMIT, LINEAR_LIMIT);
+            ext = Some(match ext {
+                None => (v, v),
+                Some((a, b)) => (a.min(v), b.max(v)),
+            });
+        }
+    }
+    ext
+}
+
+/// Widens a degenerate range (empty, or narrower than 10⁻⁹ of its magnitude)
+/// symmetrically to 20 % of its magnitude (to `[-0.5, 0.5]` around zero).
+fn widen_degenerate(lo: f64, hi: f64) -> (f64, f64) {
+    let mid = 0.5 * lo + 0.5 * hi;
+    if hi - lo > 1e-9 * mid.abs() && hi - lo >= 1e-290 {
+        return (lo, hi);
+    }
+    let half = if mid.abs() < 1e-290 {
+        0.5
+    } else {
+        0.1 * mid.abs()
+    };
+    (mid - half, mid + half)
+}
+
+/// Displayed linear range for data spanning `[min, max]` (data units): a
+/// margin of 5 % of the span each side, a degenerate range (e.g. a single
+/// value `[5, 5]` → `[4.5, 5.5]`) widened first. Zero is not forced in.
+pub fn linear_padded_range(min: f64, max: f64) -> (f64, f64) {
+    let clamp = |v: f64| {
+        if v.is_nan() {
+            0.0
+        } else {
+            v.clamp(-LINEAR_LIMIT, LINEAR_LIMIT)
+        }
+    };
+    let (a, b) = (clamp(min), clamp(max));
+    let (lo, hi) = widen_degenerate(a.min(b), a.max(b));
+    let pad = 0.05 * (hi - lo);
+    (lo - pad, hi + pad)
+}
+
+/// Linear range for a user-given `(min, max)`; `None` unless both are finite
+/// and distinct. Reversed bounds are swapped; a range too narrow to label is
+/// widened as in [`linear_padded_range`].
+pub fn explicit_linear_range(range: (f64, f64)) -> Option<(f64, f64)> {
+    let (a, b) = range;
+    if !(a.is_finite() && b.is_finite() && a != b) {
+        return None;
+    }
+    let (a, b) = (
+        a.clamp(-LINEAR_LIMIT, LINEAR_LIMIT),
+        b.clamp(-LINEAR_LIMIT, LINEAR_LIMIT),
+    );
+    Some(widen_degenerate(a.min(b), a.max(b)))
+}
+
+/// The smallest "nice" step `m·10^k` (`m` ∈ {1, 2, 5}) giving at most
+/// `max_ticks` multiples of the step inside `[lo, hi]`, as `(step, m, k)`;
+/// `None` if the range is unusable.
+fn nice_step(lo: f64, hi: f64, max_ticks: f64) -> Option<(f64, u32, i32)> {
+    let span = hi - lo;
+    if !(span.is_finite() && span > 0.0) {
+        return None;
+    }
+    let eps = 1e-9 * span;
+    let mut k = (span / max_ticks).log10().floor() as i32 - 1;
+    for _ in 0..5 {
+        for m in [1u32, 2, 5] {
+            let step = f64::from(m) * 10f64.powi(k);
+            if !(step.is_finite() && step > 0.0) {
+                continue;
+            }
+            let count = ((hi + eps) / step).floor() - ((lo - eps) / step).ceil() + 1.0;
+            if count <= max_ticks {
+                return Some((step, m, k));
+            }
+        }
+        k += 1;
+    }
+    None
+}
+
+/// Labels `i·step` for the given integer multiples with one precision for
+/// the whole axis: fixed-point (`"-0.5"`, `"0"`, `"2.5"`) for moderate
+/// magnitudes, `"1.05e-3"` / `"-1.0e6"` when the largest |tick| is ≥ 10⁵ or
+/// below 10⁻² (or fixed-point would need more than 6 decimals). Zero is
+/// always `"0"`.
+fn linear_labels(multiples: &[f64], step: f64, k: i32) -> Vec<String> {
+    let max_abs = multiples
+        .iter()
+        .map(|i| (i * step).abs())
+        .fold(0.0, f64::max);
+    let fixed_decimals = (-k).max(0);
+    let sci = max_abs >= 1e5 || (max_abs > 0.0 && max_abs < 1e-2) || fixed_decimals > 6;
+    let e = if max_abs > 0.0 {
+        (max_abs.log10() + 1e-9).floor() as i32
+    } else {
+        0
+    };
+    multiples
+        .iter()
+        .map(|&i| {
+            let v = i * step;
+            if i == 0.0 {
+                "0".to_owned()
+            } else if sci {
+                let d = (e - k).clamp(0, 16) as usize;
+                let mant = v / 10f64.powi(e);
+                format!("{mant:.d$}e{e}")
+            } else {
+                let d = fixed_decimals.min(16) as usize;
+                format!("{v:.d$}")
+            }
+        })
+        .collect()
+}
+
+/// Ticks for a linear axis showing `[lo, hi]` (data units) over `length_px`
+/// pixels, major tick labels at least `min_label_gap_px` apart.
+///
+/// * Major ticks at multiples of a 1-2-5 × 10ᵏ step, at most 8 of them
+///   (fewer if the labels would be closer than `min_label_gap_px`), each
+///   labelled with one precision per axis (see the module docs).
+/// * Unlabelled minor ticks at step/5 (step/4 for a 2 × 10ᵏ step) when they
+///   are at least 8 px apart.
+///
+/// Never panics; returns nothing for a non-finite or empty range.
+pub fn linear_ticks(lo: f64, hi: f64, length_px: f64, min_label_gap_px: f64) -> Vec<Tick> {
+    let mut ticks = Vec::new();
+    if !(lo.is_finite() && hi.is_finite()) || hi <= lo {
+        return ticks;
+    }
+    let length_px = if length_px.is_finite() && length_px > 1.0 {
+        length_px
+    } else {
+        1.0
+    };
+    let span = hi - lo;
+    let gap = if min_label_gap_px.is_finite() {
+        min_label_gap_px.max(1.0)
+    } else {
+        1.0
+    };
+    let max_ticks = (length_px / gap + 1.0).floor().clamp(2.0, MAX_LINEAR_TICKS);
+    let Some((step, m, k)) = nice_step(lo, hi, max_ticks) else {
+        return ticks;
+    };
+    let eps = 1e-9 * span;
+    let i0 = ((lo - eps) / step).ceil();
+    let i1 = ((hi + eps) / step).floor();
+    if !(i0.is_finite() && i1.is_finite()) || i1 - i0 > 2.0 * MAX_LINEAR_TICKS {
+        return ticks;
+    }
+    let multiples: Vec<f64> = (0..=((i1 - i0).max(-1.0) + 1.0) as usize)
+        .map(|j| i0 + j as f64)
+        .filter(|&i| i <= i1)
+        .collect();
+    let labels = linear_labels(&multiples, step, k);
+    let n_minor: u32 = if m == 2 { 4 } else { 5 };
+    let minor_step = step / f64::from(n_minor);
+    let show_minor = minor_step / span * length_px >= 8.0;
+    // Minor ticks run from one step below the first major to the last.
+    for (&i, label) in multiples.iter().zip(labels) {
+        if show_minor && i == i0 {
+            for j in 1..n_minor {
+                let v = (i - 1.0) * step + f64::from(j) * minor_step;
+                if v >= lo - eps {
+                    ticks.push(Tick {
+                        value: v,
+                        log: v,
+                        major: false,
+                        label: None,
+                    });
+                }
+            }
+        }
+        let v = i * step;
+        ticks.push(Tick {
+            value: v,
+            log: v,
+            major: true,
+            label: Some(label),
+        });
+        if show_minor {
+            for j in 1..n_minor {
+                let v = i * step + f64::from(j) * minor_step;
+                if v <= hi + eps {
+                    ticks.push(Tick {
+                        value: v,
+                        log: v,
+                        major: false,
+                        label: None,
+                    });
+                }
+            }
+        }
+    }
+    ticks
+}
+
+/// Map from one axis (log or linear) onto pixels. `lo`/`hi` are axis
+/// coordinates (log10 units on a log axis, data units on a linear one).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct LogMap {
+pub(crate) struct AxisMap {
+    pub scale: AxisScale,
     pub lo: f64,
     pub hi: f64,
     pub p0: f64,
     pub p1: f64,
 }
 
-impl LogMap {
-    /// Pixel of a data value; `None` unless finite and positive.
-    pub fn px(&self, v: f64) -> Option<f64> {
-        (v.is_finite() && v > 0.0).then(|| self.px_log(v.log10()))
+impl AxisMap {
+    /// Whether the axis can show `v` (finite, and positive on a log axis).
+    pub fn accepts(&self, v: f64) -> bool {
+        match self.scale {
+            AxisScale::Log => v.is_finite() && v > 0.0,
+            AxisScale::Linear => v.is_finite(),
+        }
     }
 
+    /// Pixel of a data value; `None` unless [`accepts`](Self::accepts).
+    pub fn px(&self, v: f64) -> Option<f64> {
+        if !self.accepts(v) {
+            return None;
+        }
+        Some(match self.scale {
+            AxisScale::Log => self.px_log(v.log10()),
+            AxisScale::Linear => self.px_log(v),
+        })
+    }
+
+    /// Pixel of an axis coordinate (e.g. [`Tick::log`]).
     pub fn px_log(&self, l: f64) -> f64 {
         self.p0 + (l - self.lo) / (self.hi - self.lo) * (self.p1 - self.p0)
     }

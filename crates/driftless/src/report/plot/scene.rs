@@ -39,6 +39,12 @@ pub(crate) enum Prim {
         dash: Dash,
         opacity: f64,
     },
+    /// A closed, filled polygon without outline (confidence bands).
+    Polygon {
+        pts: Vec<Pt>,
+        color: Color,
+        opacity: f64,
+    },
     Marker {
         at: Pt,
         shape: MarkerShape,

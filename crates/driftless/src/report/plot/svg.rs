@@ -131,6 +131,27 @@ fn write_prim(o: &mut String, p: &Prim) {
             }
             o.push_str("/>\n");
         }
+        Prim::Polygon {
+            pts,
+            color,
+            opacity,
+        } => {
+            if pts.len() < 3 {
+                return;
+            }
+            o.push_str("<polygon points=\"");
+            for (i, (x, y)) in pts.iter().enumerate() {
+                if i > 0 {
+                    o.push(' ');
+                }
+                let _ = write!(o, "{},{}", num(*x), num(*y));
+            }
+            let _ = write!(o, "\" fill=\"{}\" stroke=\"none\"", color.to_hex());
+            if *opacity < 1.0 {
+                let _ = write!(o, " fill-opacity=\"{}\"", num(*opacity));
+            }
+            o.push_str("/>\n");
+        }
         Prim::Marker {
             at,
             shape,
