@@ -48,6 +48,9 @@ pub struct Common {
     /// Write the calibration model file here (TOML).
     #[arg(long, value_name = "FILE.toml")]
     pub out: Option<PathBuf>,
+    /// Plot the accelerometer residuals per static interval (SVG, or PNG by extension).
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
     /// Machine-readable output.
     #[arg(long)]
     pub json: bool,
@@ -250,20 +253,37 @@ fn multi(m: MultiArgs) -> Result<()> {
         static_intervals: intervals,
         gyro_g_sensitivity: None,
     };
+    let resid: Vec<f64> = res
+        .intervals
+        .iter()
+        .map(|iv| driftless_model::linalg::norm(res.accel.calibration.apply(iv.mean_accel_raw)) - g)
+        .collect();
     let residuals: Vec<Vec<String>> = res
         .intervals
         .iter()
+        .zip(&resid)
         .enumerate()
-        .map(|(i, iv)| {
-            let a = res.accel.calibration.apply(iv.mean_accel_raw);
+        .map(|(i, (iv, r))| {
             vec![
                 format!("{}", i + 1),
                 format!("{:.2}–{:.2}", iv.start_time_s, iv.end_time_s),
                 format!("{:?}", iv.orientation),
-                format!("{:+.5}", driftless_model::linalg::norm(a) - g),
+                format!("{r:+.5}"),
             ]
         })
         .collect();
+    if let Some(p) = &m.common.plot {
+        driftless::report::calib_plot::write_residual_plot(
+            p,
+            &format!("multi-position calibration of {}", m.accel.display()),
+            &[(
+                "accelerometer after calibration",
+                "|a| − g (m/s²)",
+                resid.clone(),
+            )],
+        )
+        .with_context(|| format!("writing {}", p.display()))?;
+    }
     // Before: the nominal zero offset and the best single scale s (least squares of
     // s·|ā − o| = g over the intervals: s = g·Σ|r| / Σ|r|²).
     let r: Vec<f64> = res
@@ -382,6 +402,29 @@ fn six(s: SixArgs) -> Result<()> {
             .map(|g| g.matrix_raw_per_m_s2.0),
     };
     let g = opts.gravity_m_s2;
+    if let Some(p) = &s.common.plot {
+        let (mut norm_r, mut comp) = (Vec::new(), [Vec::new(), Vec::new(), Vec::new()]);
+        for pos in &input.positions {
+            let a = res.accel.calibration.apply(pos.accel_raw);
+            let d = driftless_model::linalg::sub(a, pos.c_bn.t().mul_vec([0.0, 0.0, -g]));
+            norm_r.push(driftless_model::linalg::norm(a) - g);
+            for k in 0..3 {
+                comp[k].push(d[k]);
+            }
+        }
+        let [cx, cy, cz] = comp;
+        driftless::report::calib_plot::write_residual_plot(
+            p,
+            &format!("six-position calibration of {}", s.log.display()),
+            &[
+                ("|a| − g", "m/s²", norm_r),
+                ("a − g·up, x", "m/s²", cx),
+                ("a − g·up, y", "m/s²", cy),
+                ("a − g·up, z", "m/s²", cz),
+            ],
+        )
+        .with_context(|| format!("writing {}", p.display()))?;
+    }
     let residuals: Vec<Vec<String>> = input
         .positions
         .iter()
@@ -501,7 +544,7 @@ fn output(
         }
         print!("{}", tab.render());
     }
-    if let Some(p) = &c.out {
+    for p in [&c.out, &c.plot].into_iter().flatten() {
         println!("\nwrote {}", p.display());
     }
     Ok(())

@@ -2,9 +2,7 @@
 //! confidence bars, the fitted noise model, and each fitted term's asymptote labelled
 //! with its value (IEEE Std 952-1997 Annex C slopes: Q −1, N −½, B 0, K +½, R +1).
 
-use super::plot::{
-    Annotation, Color, Figure, Line, LogLogPlot, PALETTE, PlotError, Series, render_png, write_svg,
-};
+use super::plot::{Annotation, Color, Figure, Line, LogLogPlot, PALETTE, PlotError, Series};
 use crate::allan::analysis::ChannelResult;
 use crate::allan::fit::{NoiseFit, gauss_markov_avar};
 use crate::io::log::Quantity;
@@ -238,14 +236,5 @@ pub fn write(
     units: &[String],
     fits: &[Option<&NoiseFit>],
 ) -> Result<(), PlotError> {
-    let fig = figure(title, results, quantities, units, fits);
-    let is_png = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    if is_png {
-        render_png(&fig, path)
-    } else {
-        write_svg(&fig, path)
-    }
+    super::plot::write_figure(&figure(title, results, quantities, units, fits), path)
 }

@@ -71,6 +71,20 @@ pub const PNG_SUPPORTED: bool = cfg!(feature = "png");
 /// high-DPI screens and in print).
 pub const DEFAULT_PNG_SCALE: f64 = 2.0;
 
+/// Writes the figure as PNG when `path` ends in `.png` (any case), else as SVG.
+pub fn write_figure(fig: &Figure, path: impl AsRef<Path>) -> Result<(), PlotError> {
+    let path = path.as_ref();
+    let is_png = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if is_png {
+        render_png(fig, path)
+    } else {
+        write_svg(fig, path)
+    }
+}
+
 /// Renders the figure as a self-contained SVG document (UTF-8, no XML
 /// declaration, no ids, no external resources: it can be written to a `.svg`
 /// file or inlined in HTML as is).
