@@ -22,8 +22,8 @@
 //!
 //! i.e. out = M(T)·(raw − b(T)) with the effective calibration at T
 //! b(T) = b + Δb(T), M(T) = M·diag(1/(1 + Δs(T))) ([`CompensationModel::calibration_at`]).
-//! This is the usual inverse of the sensor error model (Groves 2013, *Principles of
-//! GNSS, Inertial, and Multisensor Integrated Navigation Systems*, 2nd ed., §4.4 (inertial sensor error models):
+//! This is the usual inverse of the inertial-sensor error model (Groves 2013, *Principles
+//! of GNSS, Inertial, and Multisensor Integrated Navigation Systems*, 2nd ed., §4.4:
 //! ỹ = b + (I + M_s)·y, solved for y) with temperature-dependent b and M_s.
 //!
 //! ## Derivation: exact inverse of the simulator's deterministic model
