@@ -3,21 +3,9 @@
 //! Xsens recording (shared data), the `--json` schema and bad input.
 
 use std::path::PathBuf;
-use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_driftless"))
-}
-
-fn run_json(cmd: &mut Command) -> serde_json::Value {
-    let out = cmd.output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
+mod common;
+use common::{bin, run_json};
 
 fn matrix(v: &serde_json::Value) -> [[f64; 3]; 3] {
     std::array::from_fn(|r| std::array::from_fn(|c| v[r][c].as_f64().unwrap()))

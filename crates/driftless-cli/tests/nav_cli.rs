@@ -5,11 +5,9 @@
 use driftless::io::nav::{GnssFixes, ImuIncrements, write_kfgins_gnss, write_kfgins_imu};
 use driftless::nav::attitude::Euler;
 use driftless::sim::ideal_imu::{ConstantTurn, Trajectory, ideal_increments};
-use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_driftless"))
-}
+mod common;
+use common::bin;
 
 fn turn() -> ConstantTurn {
     ConstantTurn {
