@@ -2,7 +2,7 @@
 //! the temperature difference ΔT = T − T_ref, seed paper §3.3 eqs. 1–2
 //! (cubics about t₀ = 25 °C fitted by least squares to soak-test results over −25…70 °C).
 //!
-//! * [`fit`]: the polynomial fit (order 1–5, default 3) by Householder QR on a centred,
+//! * [`fit`](mod@fit): the polynomial fit (order 1–5, default 3) by Householder QR on a centred,
 //!   scaled temperature, with coefficient covariance, residual RMS, χ²/dof, confidence
 //!   band, leave-one-temperature-out cross-validation and AIC/BIC order advice. Its
 //!   result carries a [`driftless_model::thermal::ThermalPoly`] for compensation.

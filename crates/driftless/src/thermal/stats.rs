@@ -1,4 +1,4 @@
-//! Student-t and normal quantiles for the confidence intervals of [`super::fit`].
+//! Student-t and normal quantiles for the confidence intervals of [`super::fit`](mod@super::fit).
 //!
 //! The Student-t distribution function is evaluated through the regularized incomplete
 //! beta function (Abramowitz & Stegun 26.7.1, 26.5.8 continued fraction, evaluated with
