@@ -15,3 +15,4 @@ pub mod io;
 pub mod nav;
 pub mod report;
 pub mod sim;
+pub mod thermal;

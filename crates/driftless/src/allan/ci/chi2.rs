@@ -141,7 +141,7 @@ pub fn gamma_pq(a: f64, x: f64) -> (f64, f64) {
 
 /// Standard normal quantile (Acklam's rational approximation, |rel. error| < 1.2e-9);
 /// used only as a starting point.
-fn normal_quantile(p: f64) -> f64 {
+pub(crate) fn normal_quantile(p: f64) -> f64 {
     const A: [f64; 6] = [
         -3.969_683_028_665_376e1,
         2.209_460_984_245_205e2,

@@ -1,0 +1,779 @@
+//! Least-squares thermal polynomial fit by Householder QR on a centred, scaled
+//! temperature (issue 6, deliverable 3; seed paper §3.3 eqs. 1–2).
+//!
+//! # Model
+//!
+//! ```text
+//! y(T) = Σ_{k=0}^{p} c_k (T − T_ref)^k,      p = 1 … 5 (default 3), T_ref = 25 °C
+//! ```
+//!
+//! # Solution
+//!
+//! A Vandermonde matrix in ΔT = T − T_ref is badly conditioned (columns ΔT⁰ … ΔT⁵ span
+//! ~10 decades over −25…70 °C), and the normal equations square that condition number.
+//! The fit is therefore made in the scaled variable
+//!
+//! ```text
+//! u = (T − T_c)/h,   T_c = (T_min + T_max)/2,   h = (T_max − T_min)/2,   u ∈ [−1, 1]
+//! ```
+//!
+//! by Householder QR of the (row-weighted) Vandermonde matrix V_ij = w_i u_iʲ, w_i = 1/σ_i
+//! (or 1): V = QR, R a = (Qᵀ w y)[0..m], m = p + 1 (Golub & Van Loan, *Matrix
+//! Computations*, 4th ed., §5.1–5.3). Cov(a) = s² R⁻¹R⁻ᵀ, with s² = 1 when σ_i are given
+//! (weights 1/σ_i²), or s² = RSS/(n − m) when the noise level is estimated from the
+//! residuals.
+//!
+//! The scaled coefficients a are mapped *exactly* to powers of ΔT with d = T_c − T_ref:
+//!
+//! ```text
+//! uʲ = h⁻ʲ (ΔT − d)ʲ = h⁻ʲ Σ_{k≤j} C(j,k) ΔTᵏ (−d)^{j−k}
+//! c = M a,  M_kj = h⁻ʲ C(j,k) (−d)^{j−k}  (k ≤ j),     Cov(c) = M Cov(a) Mᵀ
+//! ```
+//!
+//! # Input policy
+//!
+//! * Temperatures need not be sorted (least squares is permutation-invariant; the
+//!   cross-validation groups them internally). Repeated temperatures are allowed as
+//!   repeated measurements, but the number of *distinct* temperatures (exact `f64`
+//!   equality) must be at least p + 1.
+//! * NaN/infinite temperatures or values, σ_i ≤ 0 or non-finite, and mismatched lengths
+//!   are errors naming the first offending index.
+//! * Without σ_i the noise level is estimated from the residuals, which needs n ≥ p + 2
+//!   points.
+
+use driftless_model::thermal::{MAX_ORDER, ThermalPoly, ThermalPolyError};
+
+use super::stats::{normal_quantile, student_t_quantile};
+
+/// Why a thermal fit could not be made.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ThermalFitError {
+    /// The polynomial order is outside 1 ..= 5.
+    #[error("polynomial order {0} not supported (1..={MAX_ORDER})")]
+    BadOrder(usize),
+    /// Two input slices have different lengths.
+    #[error("{what} has {got} entries, expected {expected} (one per temperature)")]
+    LengthMismatch {
+        /// Which input.
+        what: &'static str,
+        /// Number of temperatures.
+        expected: usize,
+        /// Entries given.
+        got: usize,
+    },
+    /// A temperature is NaN or infinite (its index).
+    #[error("temperature #{0} is not finite")]
+    NonFiniteTemperature(usize),
+    /// A value is NaN or infinite (its index).
+    #[error("value #{0} is not finite")]
+    NonFiniteValue(usize),
+    /// A standard error is ≤ 0, NaN or infinite (its index).
+    #[error("standard error #{0} must be finite and > 0")]
+    BadSigma(usize),
+    /// The reference temperature is NaN or infinite.
+    #[error("reference temperature is not finite")]
+    NonFiniteReference,
+    /// Not enough distinct temperatures to determine the polynomial.
+    #[error("{distinct} distinct temperature(s) cannot determine an order-{order} polynomial (need at least {})", order + 1)]
+    TooFewTemperatures {
+        /// Distinct temperatures given.
+        distinct: usize,
+        /// Requested order.
+        order: usize,
+    },
+    /// Without per-point σ the noise level is estimated from the residuals, which needs
+    /// at least one residual degree of freedom.
+    #[error(
+        "{points} points leave no residual degree of freedom for an order-{order} fit without given standard errors"
+    )]
+    NoResidualDof {
+        /// Points given.
+        points: usize,
+        /// Requested order.
+        order: usize,
+    },
+    /// The weighted design matrix is numerically rank-deficient.
+    #[error("the design matrix is numerically rank-deficient (column {0})")]
+    RankDeficient(usize),
+    /// The confidence level is not in (0, 1).
+    #[error("confidence level {0} is not in (0, 1)")]
+    BadLevel(f64),
+    /// The coefficient index is above the fitted order.
+    #[error("coefficient c{index} does not exist in an order-{order} fit")]
+    NoSuchCoefficient {
+        /// Requested index.
+        index: usize,
+        /// Fitted order.
+        order: usize,
+    },
+    /// The fitted polynomial could not be represented (non-finite coefficients).
+    #[error("fitted polynomial rejected: {0}")]
+    Poly(ThermalPolyError),
+}
+
+/// Fit settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FitOptions {
+    /// Polynomial order p, 1 ..= 5 (default 3, seed paper §3.3).
+    pub order: usize,
+    /// Reference temperature T_ref, °C (default 25 °C, seed paper §3.3).
+    pub t_ref_c: f64,
+    /// When σ_i are given: also scale the covariance by χ²/dof (Birge ratio) and use
+    /// Student-t coverage factors — for σ_i that are only relative weights. Default
+    /// `false`: the σ_i are taken as absolute.
+    pub rescale_given_sigma: bool,
+}
+
+impl Default for FitOptions {
+    fn default() -> FitOptions {
+        FitOptions {
+            order: 3,
+            t_ref_c: 25.0,
+            rescale_given_sigma: false,
+        }
+    }
+}
+
+/// Where the coefficient covariance's noise scale comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NoiseScale {
+    /// Absolute per-point σ_i: Cov = (VᵀWV)⁻¹, normal coverage factors.
+    Given,
+    /// Estimated: s² = RSS_w/(n − p − 1) (RSS_w = χ² when σ_i are given as relative
+    /// weights); Student-t coverage factors with n − p − 1 dof.
+    Estimated,
+}
+
+/// Result of [`fit`]: y(T) = Σ c_k (T − T_ref)^k with uncertainties.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ThermalFit {
+    /// The fitted polynomial (coefficients about T_ref, valid range [min T, max T]).
+    pub poly: ThermalPoly,
+    /// Order p.
+    pub order: usize,
+    /// Coefficients c_0 … c_p of (T − T_ref)^k.
+    pub coeffs: Vec<f64>,
+    /// Covariance of the coefficients, (p+1)×(p+1) row-major.
+    pub covariance: Vec<f64>,
+    /// Standard errors √Cov_kk.
+    pub std_errors: Vec<f64>,
+    /// √(Σ r_i²/n), r_i = y_i − ŷ(T_i) (unweighted), in the unit of y.
+    pub residual_rms: f64,
+    /// χ² = Σ (r_i/σ_i)² when σ_i are given.
+    pub chi2: Option<f64>,
+    /// χ²/(n − p − 1) when σ_i are given and n > p + 1.
+    pub chi2_per_dof: Option<f64>,
+    /// Residual degrees of freedom n − p − 1.
+    pub dof: usize,
+    /// Points used.
+    pub n_points: usize,
+    /// Distinct temperatures.
+    pub n_distinct: usize,
+    /// How the covariance is scaled.
+    pub noise_scale: NoiseScale,
+    t_centre: f64,
+    half_range: f64,
+    /// Scaled coefficients a_j of u^j, u = (T − T_c)/h.
+    coeffs_scaled: Vec<f64>,
+    /// Cov(a) of the scaled coefficients (row-major), used for the band.
+    cov_scaled: Vec<f64>,
+}
+
+/// A confidence band value at one temperature.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BandPoint {
+    /// Fitted value ŷ(T).
+    pub value: f64,
+    /// Standard error of the fitted curve σ_fit(T) = √(gᵀ C g).
+    pub std_error: f64,
+    /// Lower bound ŷ − k σ_fit.
+    pub lo: f64,
+    /// Upper bound ŷ + k σ_fit.
+    pub hi: f64,
+}
+
+impl ThermalFit {
+    /// Reference temperature, °C.
+    pub fn t_ref_c(&self) -> f64 {
+        self.poly.t_ref_c()
+    }
+
+    /// Valid range [min T, max T], °C.
+    pub fn range_c(&self) -> (f64, f64) {
+        self.poly.range_c()
+    }
+
+    /// Fitted value at `t_c` (evaluated on the scaled basis; agrees with
+    /// `self.poly.eval` to rounding).
+    pub fn eval(&self, t_c: f64) -> f64 {
+        horner_scaled(&self.coeffs_scaled, self.t_centre, self.half_range, t_c)
+    }
+
+    /// Two-sided coverage factor for `level` (e.g. 0.95): z_{(1+level)/2} for
+    /// [`NoiseScale::Given`], t_{n−p−1, (1+level)/2} for [`NoiseScale::Estimated`].
+    pub fn coverage_factor(&self, level: f64) -> Result<f64, ThermalFitError> {
+        if !(level > 0.0 && level < 1.0) {
+            return Err(ThermalFitError::BadLevel(level));
+        }
+        let p = 0.5 * (1.0 + level);
+        Ok(match self.noise_scale {
+            NoiseScale::Given => normal_quantile(p),
+            NoiseScale::Estimated => student_t_quantile(p, self.dof as f64),
+        })
+    }
+
+    /// Standard error of the fitted curve at `t_c`: σ_fit(T)² = gᵀ C g,
+    /// g = (1, ΔT, …, ΔT^p) — computed in the equivalent scaled basis
+    /// g_u = (1, u, …, u^p), σ² = g_uᵀ Cov(a) g_u, for conditioning.
+    pub fn std_error_at(&self, t_c: f64) -> f64 {
+        let m = self.order + 1;
+        let u = (t_c - self.t_centre) / self.half_range;
+        let mut g = vec![1.0; m];
+        for j in 1..m {
+            g[j] = g[j - 1] * u;
+        }
+        let mut v = 0.0;
+        for i in 0..m {
+            for j in 0..m {
+                v += g[i] * self.cov_scaled[i * m + j] * g[j];
+            }
+        }
+        v.max(0.0).sqrt()
+    }
+
+    /// Confidence band of the fitted curve at `t_c`: ŷ ± k σ_fit(T) with k from
+    /// [`ThermalFit::coverage_factor`] (a pointwise, not simultaneous, band).
+    pub fn band(&self, t_c: f64, level: f64) -> Result<BandPoint, ThermalFitError> {
+        let k = self.coverage_factor(level)?;
+        let value = self.eval(t_c);
+        let s = self.std_error_at(t_c);
+        Ok(BandPoint {
+            value,
+            std_error: s,
+            lo: value - k * s,
+            hi: value + k * s,
+        })
+    }
+
+    /// Confidence interval (lo, hi) = c_k ± factor · σ(c_k) of coefficient `index`.
+    pub fn coeff_interval(&self, index: usize, level: f64) -> Result<(f64, f64), ThermalFitError> {
+        if index > self.order {
+            return Err(ThermalFitError::NoSuchCoefficient {
+                index,
+                order: self.order,
+            });
+        }
+        let k = self.coverage_factor(level)?;
+        let c = self.coeffs[index];
+        let s = self.std_errors[index];
+        Ok((c - k * s, c + k * s))
+    }
+}
+
+/// Householder QR least-squares solution on the scaled basis.
+struct Core {
+    t_centre: f64,
+    half_range: f64,
+    /// Scaled coefficients a_0 … a_p.
+    a: Vec<f64>,
+    /// R⁻¹ (upper triangular, m×m row-major).
+    r_inv: Vec<f64>,
+    /// Weighted residual sum of squares ‖w ⊙ (y − ŷ)‖².
+    rss_w: f64,
+}
+
+/// Validate inputs; returns the number of distinct temperatures.
+fn validate(
+    t_c: &[f64],
+    y: &[f64],
+    sigma: Option<&[f64]>,
+    order: usize,
+    t_ref_c: f64,
+) -> Result<usize, ThermalFitError> {
+    if !(1..=MAX_ORDER).contains(&order) {
+        return Err(ThermalFitError::BadOrder(order));
+    }
+    if !t_ref_c.is_finite() {
+        return Err(ThermalFitError::NonFiniteReference);
+    }
+    let n = t_c.len();
+    if y.len() != n {
+        return Err(ThermalFitError::LengthMismatch {
+            what: "values",
+            expected: n,
+            got: y.len(),
+        });
+    }
+    if let Some(s) = sigma {
+        if s.len() != n {
+            return Err(ThermalFitError::LengthMismatch {
+                what: "standard errors",
+                expected: n,
+                got: s.len(),
+            });
+        }
+        if let Some(i) = s.iter().position(|&v| !(v.is_finite() && v > 0.0)) {
+            return Err(ThermalFitError::BadSigma(i));
+        }
+    }
+    if let Some(i) = t_c.iter().position(|v| !v.is_finite()) {
+        return Err(ThermalFitError::NonFiniteTemperature(i));
+    }
+    if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+        return Err(ThermalFitError::NonFiniteValue(i));
+    }
+    let distinct = distinct_groups(t_c).len();
+    if distinct < order + 1 {
+        return Err(ThermalFitError::TooFewTemperatures { distinct, order });
+    }
+    Ok(distinct)
+}
+
+/// Indices grouped by equal temperature, groups in ascending temperature order.
+fn distinct_groups(t_c: &[f64]) -> Vec<Vec<usize>> {
+    let mut idx: Vec<usize> = (0..t_c.len()).collect();
+    idx.sort_by(|&a, &b| t_c[a].total_cmp(&t_c[b]));
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for i in idx {
+        match groups.last_mut() {
+            Some(g) if t_c[g[0]] == t_c[i] => g.push(i),
+            _ => groups.push(vec![i]),
+        }
+    }
+    groups
+}
+
+/// Weighted least squares on u = (T − T_c)/h over the points `idx` by Householder QR
+/// (Golub & Van Loan §5.1.2 Householder vectors, §5.3.3 LS via QR).
+fn solve_scaled(
+    t_c: &[f64],
+    y: &[f64],
+    sigma: Option<&[f64]>,
+    idx: &[usize],
+    m: usize,
+) -> Result<Core, ThermalFitError> {
+    let n = idx.len();
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &i in idx {
+        lo = lo.min(t_c[i]);
+        hi = hi.max(t_c[i]);
+    }
+    let t_centre = 0.5 * (lo + hi);
+    let half_range = if hi > lo { 0.5 * (hi - lo) } else { 1.0 };
+    // Weighted design A (n×m row-major) and right-hand side b.
+    let mut a = vec![0.0; n * m];
+    let mut b = vec![0.0; n];
+    for (r, &i) in idx.iter().enumerate() {
+        let w = sigma.map_or(1.0, |s| 1.0 / s[i]);
+        let u = (t_c[i] - t_centre) / half_range;
+        let mut p = w;
+        for j in 0..m {
+            a[r * m + j] = p;
+            p *= u;
+        }
+        b[r] = w * y[i];
+    }
+    // Householder triangularisation, applying each reflector to b as well.
+    let mut diag_max: f64 = 0.0;
+    for k in 0..m {
+        let norm = (k..n).map(|r| a[r * m + k].powi(2)).sum::<f64>().sqrt();
+        if norm == 0.0 {
+            return Err(ThermalFitError::RankDeficient(k));
+        }
+        let alpha = if a[k * m + k] > 0.0 { -norm } else { norm };
+        // v = x − α e₁, stored in place of column k (rows k..n).
+        a[k * m + k] -= alpha;
+        let vtv: f64 = (k..n).map(|r| a[r * m + k].powi(2)).sum();
+        if vtv > 0.0 {
+            for j in (k + 1)..m {
+                let s: f64 = (k..n).map(|r| a[r * m + k] * a[r * m + j]).sum();
+                let f = 2.0 * s / vtv;
+                for r in k..n {
+                    a[r * m + j] -= f * a[r * m + k];
+                }
+            }
+            let s: f64 = (k..n).map(|r| a[r * m + k] * b[r]).sum();
+            let f = 2.0 * s / vtv;
+            for r in k..n {
+                b[r] -= f * a[r * m + k];
+            }
+        }
+        a[k * m + k] = alpha;
+        diag_max = diag_max.max(alpha.abs());
+    }
+    let tol = 1e-13 * diag_max * (n as f64);
+    if let Some(k) = (0..m).find(|&k| a[k * m + k].abs() <= tol) {
+        return Err(ThermalFitError::RankDeficient(k));
+    }
+    // Back substitution R x = (Qᵀb)[0..m].
+    let mut x = vec![0.0; m];
+    for k in (0..m).rev() {
+        let s: f64 = ((k + 1)..m).map(|j| a[k * m + j] * x[j]).sum();
+        x[k] = (b[k] - s) / a[k * m + k];
+    }
+    // R⁻¹ column by column (upper triangular).
+    let mut r_inv = vec![0.0; m * m];
+    for c in 0..m {
+        for k in (0..=c).rev() {
+            let rhs = if k == c { 1.0 } else { 0.0 };
+            let s: f64 = ((k + 1)..=c).map(|j| a[k * m + j] * r_inv[j * m + c]).sum();
+            r_inv[k * m + c] = (rhs - s) / a[k * m + k];
+        }
+    }
+    // Residuals recomputed directly (more accurate than ‖(Qᵀb)[m..]‖ when tiny).
+    let mut rss_w = 0.0;
+    for &i in idx {
+        let w = sigma.map_or(1.0, |s| 1.0 / s[i]);
+        let r = y[i] - horner_scaled(&x, t_centre, half_range, t_c[i]);
+        rss_w += (w * r).powi(2);
+    }
+    Ok(Core {
+        t_centre,
+        half_range,
+        a: x,
+        r_inv,
+        rss_w,
+    })
+}
+
+/// Σ a_j u^j with u = (T − T_c)/h (Horner).
+fn horner_scaled(a: &[f64], t_centre: f64, half_range: f64, t_c: f64) -> f64 {
+    let u = (t_c - t_centre) / half_range;
+    a.iter().rev().fold(0.0, |acc, &c| acc * u + c)
+}
+
+/// Binomial coefficient C(j, k) for j ≤ 5 (exact in f64).
+fn binom(j: usize, k: usize) -> f64 {
+    (0..k).fold(1.0, |acc, i| acc * (j - i) as f64 / (i + 1) as f64)
+}
+
+/// The map M with c = M a (see module docs), m×m row-major; d = T_c − T_ref.
+fn scaled_to_dt(m: usize, d: f64, h: f64) -> Vec<f64> {
+    let mut mm = vec![0.0; m * m];
+    for j in 0..m {
+        let hj = h.powi(-(j as i32));
+        for k in 0..=j {
+            mm[k * m + j] = hj * binom(j, k) * (-d).powi((j - k) as i32);
+        }
+    }
+    mm
+}
+
+/// Fit y(T) = Σ c_k (T − T_ref)^k to `(t_c[i], y[i])`, optionally weighted by 1/σ_i².
+///
+/// See the module docs for the algorithm and the input policy.
+pub fn fit(
+    t_c: &[f64],
+    y: &[f64],
+    sigma: Option<&[f64]>,
+    opts: &FitOptions,
+) -> Result<ThermalFit, ThermalFitError> {
+    let order = opts.order;
+    let n_distinct = validate(t_c, y, sigma, order, opts.t_ref_c)?;
+    let n = t_c.len();
+    let m = order + 1;
+    let dof = n - m;
+    let noise_scale = match sigma {
+        Some(_) if !opts.rescale_given_sigma => NoiseScale::Given,
+        _ => NoiseScale::Estimated,
+    };
+    if noise_scale == NoiseScale::Estimated && dof == 0 {
+        return Err(ThermalFitError::NoResidualDof { points: n, order });
+    }
+    let idx: Vec<usize> = (0..n).collect();
+    let core = solve_scaled(t_c, y, sigma, &idx, m)?;
+    let s2 = match noise_scale {
+        NoiseScale::Given => 1.0,
+        NoiseScale::Estimated => core.rss_w / dof as f64,
+    };
+    // Cov(a) = s² R⁻¹ R⁻ᵀ.
+    let mut cov_a = vec![0.0; m * m];
+    for i in 0..m {
+        for j in 0..m {
+            let s: f64 = (i.max(j)..m)
+                .map(|k| core.r_inv[i * m + k] * core.r_inv[j * m + k])
+                .sum();
+            cov_a[i * m + j] = s2 * s;
+        }
+    }
+    let d = core.t_centre - opts.t_ref_c;
+    let mm = scaled_to_dt(m, d, core.half_range);
+    let coeffs: Vec<f64> = (0..m)
+        .map(|k| (0..m).map(|j| mm[k * m + j] * core.a[j]).sum())
+        .collect();
+    // Cov(c) = M Cov(a) Mᵀ.
+    let mut tmp = vec![0.0; m * m];
+    for i in 0..m {
+        for j in 0..m {
+            tmp[i * m + j] = (0..m).map(|k| mm[i * m + k] * cov_a[k * m + j]).sum();
+        }
+    }
+    let mut covariance = vec![0.0; m * m];
+    for i in 0..m {
+        for j in 0..m {
+            covariance[i * m + j] = (0..m).map(|k| tmp[i * m + k] * mm[j * m + k]).sum();
+        }
+    }
+    let std_errors = (0..m)
+        .map(|k| covariance[k * m + k].max(0.0).sqrt())
+        .collect();
+    let (t_min, t_max) = t_c
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
+            (lo.min(t), hi.max(t))
+        });
+    let poly =
+        ThermalPoly::new(opts.t_ref_c, &coeffs, t_min, t_max).map_err(ThermalFitError::Poly)?;
+    let rss: f64 = (0..n)
+        .map(|i| (y[i] - horner_scaled(&core.a, core.t_centre, core.half_range, t_c[i])).powi(2))
+        .sum();
+    let chi2 = sigma.map(|_| core.rss_w);
+    let chi2_per_dof = chi2.filter(|_| dof > 0).map(|c| c / dof as f64);
+    Ok(ThermalFit {
+        poly,
+        order,
+        coeffs,
+        covariance,
+        std_errors,
+        residual_rms: (rss / n as f64).sqrt(),
+        chi2,
+        chi2_per_dof,
+        dof,
+        n_points: n,
+        n_distinct,
+        noise_scale,
+        t_centre: core.t_centre,
+        half_range: core.half_range,
+        coeffs_scaled: core.a,
+        cov_scaled: cov_a,
+    })
+}
+
+/// Leave-one-temperature-out cross-validation result.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CrossValidation {
+    /// Order p.
+    pub order: usize,
+    /// Prediction residual y_i − ŷ_{−T_i}(T_i) of each input point (input order), where
+    /// ŷ_{−T_i} is refitted without every point at temperature T_i.
+    pub residuals: Vec<f64>,
+    /// √(Σ residuals²/n) (unweighted), in the unit of y.
+    pub rms: f64,
+}
+
+/// Leave-one-temperature-out CV: for each distinct temperature, refit (same weights,
+/// same order) without all points at it and predict it. Removing an end temperature makes
+/// that prediction an extrapolation — deliberately: it measures how the order behaves at
+/// the edges, where cubics go wrong. Needs at least p + 2 distinct temperatures.
+pub fn cross_validate(
+    t_c: &[f64],
+    y: &[f64],
+    sigma: Option<&[f64]>,
+    opts: &FitOptions,
+) -> Result<CrossValidation, ThermalFitError> {
+    let order = opts.order;
+    let distinct = validate(t_c, y, sigma, order, opts.t_ref_c)?;
+    if distinct < order + 2 {
+        return Err(ThermalFitError::TooFewTemperatures {
+            distinct: distinct - 1,
+            order,
+        });
+    }
+    let groups = distinct_groups(t_c);
+    let n = t_c.len();
+    let mut residuals = vec![0.0; n];
+    let mut keep = Vec::with_capacity(n);
+    for (g, group) in groups.iter().enumerate() {
+        keep.clear();
+        for (h, other) in groups.iter().enumerate() {
+            if h != g {
+                keep.extend_from_slice(other);
+            }
+        }
+        let core = solve_scaled(t_c, y, sigma, &keep, order + 1)?;
+        for &i in group {
+            residuals[i] = y[i] - horner_scaled(&core.a, core.t_centre, core.half_range, t_c[i]);
+        }
+    }
+    let rms = (residuals.iter().map(|r| r * r).sum::<f64>() / n as f64).sqrt();
+    Ok(CrossValidation {
+        order,
+        residuals,
+        rms,
+    })
+}
+
+/// One candidate order in [`OrderAdvice`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrderRow {
+    /// Order p.
+    pub order: usize,
+    /// Residual RMS of the fit.
+    pub residual_rms: f64,
+    /// χ²/dof when σ_i are given.
+    pub chi2_per_dof: Option<f64>,
+    /// Akaike information criterion −2 ln L̂ + 2K.
+    pub aic: f64,
+    /// Small-sample AICc = AIC + 2K(K+1)/(n − K − 1) (+∞ when n ≤ K + 1).
+    pub aicc: f64,
+    /// Bayesian (Schwarz) criterion −2 ln L̂ + K ln n.
+    pub bic: f64,
+    /// Leave-one-temperature-out CV RMS.
+    pub cv_rms: f64,
+}
+
+/// Order advice over p = 1 ..= min(5, n_distinct − 2) (the upper limit keeps the
+/// cross-validation defined).
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrderAdvice {
+    /// One row per candidate order, ascending.
+    pub rows: Vec<OrderRow>,
+    /// Order with the lowest BIC (ties → lower order).
+    pub min_bic: usize,
+    /// Recommended order: the lowest order whose BIC is within [`BIC_PARSIMONY`] (= 2) of
+    /// the minimum — a higher order is adopted only on at least "positive" evidence
+    /// (ΔBIC > 2, Kass & Raftery, JASA 90:773, 1995). BIC's ln n penalty already favours
+    /// parsimony more than AIC, which suits extrapolation-prone polynomials (Burnham &
+    /// Anderson 2002, §6.3); the ΔBIC margin further cuts spurious quartics/quintics.
+    pub recommended: usize,
+}
+
+/// ΔBIC margin below which the lower order is preferred (see [`OrderAdvice::recommended`]).
+pub const BIC_PARSIMONY: f64 = 2.0;
+
+/// Compare orders by AIC, AICc, BIC and CV (Burnham & Anderson, *Model Selection and
+/// Multimodel Inference*, 2nd ed., 2002, §2.2–2.4, §6.3), with the Gaussian likelihood:
+///
+/// ```text
+/// σ unknown:  −2 ln L̂ = n [ln(2π RSS/n) + 1],        K = p + 2  (c₀…c_p and σ²)
+/// σ_i given:  −2 ln L̂ = χ² + Σ ln(2π σ_i²),          K = p + 1
+/// AIC = −2 ln L̂ + 2K,   AICc = AIC + 2K(K+1)/(n−K−1),   BIC = −2 ln L̂ + K ln n
+/// ```
+///
+/// (`rescale_given_sigma` and `order` in `opts` are ignored; RSS is floored at
+/// n·(10⁻¹⁴ max|y|)² so noise-free data do not give −∞.)
+pub fn advise_order(
+    t_c: &[f64],
+    y: &[f64],
+    sigma: Option<&[f64]>,
+    t_ref_c: f64,
+) -> Result<OrderAdvice, ThermalFitError> {
+    let distinct = validate(t_c, y, sigma, 1, t_ref_c)?;
+    if distinct < 3 {
+        return Err(ThermalFitError::TooFewTemperatures { distinct, order: 1 });
+    }
+    let n = t_c.len();
+    let nf = n as f64;
+    let max_order = MAX_ORDER.min(distinct - 2);
+    let ymax = y.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let floor = nf * (1e-14 * ymax).powi(2);
+    let ln2pi = (2.0 * std::f64::consts::PI).ln();
+    let mut rows = Vec::with_capacity(max_order);
+    for order in 1..=max_order {
+        let opts = FitOptions {
+            order,
+            t_ref_c,
+            rescale_given_sigma: false,
+        };
+        let f = fit(t_c, y, sigma, &opts)?;
+        let cv = cross_validate(t_c, y, sigma, &opts)?;
+        let (m2ll, k) = match (sigma, f.chi2) {
+            (Some(s), Some(chi2)) => (
+                chi2.max(floor) + s.iter().map(|v| ln2pi + 2.0 * v.ln()).sum::<f64>(),
+                order + 1,
+            ),
+            _ => {
+                let rss = (f.residual_rms.powi(2) * nf).max(floor.max(f64::MIN_POSITIVE));
+                (nf * (ln2pi + (rss / nf).ln() + 1.0), order + 2)
+            }
+        };
+        let kf = k as f64;
+        let aic = m2ll + 2.0 * kf;
+        let aicc = if nf > kf + 1.0 {
+            aic + 2.0 * kf * (kf + 1.0) / (nf - kf - 1.0)
+        } else {
+            f64::INFINITY
+        };
+        rows.push(OrderRow {
+            order,
+            residual_rms: f.residual_rms,
+            chi2_per_dof: f.chi2_per_dof,
+            aic,
+            aicc,
+            bic: m2ll + kf * nf.ln(),
+            cv_rms: cv.rms,
+        });
+    }
+    let mut min_bic = rows.first().map_or(1, |r| r.order);
+    let mut best = f64::INFINITY;
+    for r in &rows {
+        if r.bic < best {
+            best = r.bic;
+            min_bic = r.order;
+        }
+    }
+    let recommended = rows
+        .iter()
+        .find(|r| r.bic <= best + BIC_PARSIMONY)
+        .map_or(min_bic, |r| r.order);
+    Ok(OrderAdvice {
+        rows,
+        min_bic,
+        recommended,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn binomials() {
+        assert_eq!(binom(5, 0), 1.0);
+        assert_eq!(binom(5, 2), 10.0);
+        assert_eq!(binom(4, 4), 1.0);
+    }
+
+    #[test]
+    fn scaled_to_dt_map_is_exact_reexpansion() {
+        // Σ a_j u^j and Σ (M a)_k ΔT^k agree at any T.
+        let (tc, h, tref) = (22.5, 47.5, 25.0);
+        let a = [0.3, -1.2, 0.7, 0.25, -0.1, 0.05];
+        let mm = scaled_to_dt(6, tc - tref, h);
+        let c: Vec<f64> = (0..6)
+            .map(|k| (0..6).map(|j| mm[k * 6 + j] * a[j]).sum())
+            .collect();
+        for t in [-40.0, -25.0, 0.0, 25.0, 70.0, 85.0] {
+            let u = horner_scaled(&a, tc, h, t);
+            let dt = c.iter().rev().fold(0.0, |acc, &v| acc * (t - tref) + v);
+            assert!(
+                (u - dt).abs() < 1e-13 * u.abs().max(1.0),
+                "{t}: {u} vs {dt}"
+            );
+        }
+    }
+
+    #[test]
+    fn groups_sort_and_merge_repeats() {
+        let g = distinct_groups(&[30.0, -10.0, 30.0, 5.0, -10.0]);
+        assert_eq!(g, vec![vec![1, 4], vec![3], vec![0, 2]]);
+    }
+
+    #[test]
+    fn qr_matches_straight_line() {
+        // y = 1 + 2 (T − 25) exactly through three points; covariance of a line fit
+        // with σ = 1: Var(c1) = 1/Σ(T − T̄)².
+        let t = [15.0, 25.0, 35.0];
+        let y = [-19.0, 1.0, 21.0];
+        let s = [1.0; 3];
+        let o = FitOptions {
+            order: 1,
+            ..FitOptions::default()
+        };
+        let f = fit(&t, &y, Some(&s), &o).unwrap();
+        assert!((f.coeffs[0] - 1.0).abs() < 1e-14 && (f.coeffs[1] - 2.0).abs() < 1e-14);
+        assert!((f.covariance[3] - 1.0 / 200.0).abs() < 1e-16);
+        assert!((f.covariance[0] - 1.0 / 3.0).abs() < 1e-15);
+        assert_eq!(f.dof, 1);
+    }
+}

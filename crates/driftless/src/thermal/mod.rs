@@ -1,0 +1,19 @@
+//! Thermal models (issue 6): a sensor parameter (bias, scale factor …) as a polynomial in
+//! the temperature difference ΔT = T − T_ref, seed paper §3.3 eqs. 1–2
+//! (cubics about t₀ = 25 °C fitted by least squares to soak-test results over −25…70 °C).
+//!
+//! * [`fit`](mod@fit): the polynomial fit (order 1–5, default 3) by Householder QR on a centred,
+//!   scaled temperature, with coefficient covariance, residual RMS, χ²/dof, confidence
+//!   band, leave-one-temperature-out cross-validation and AIC/BIC order advice. Its
+//!   result carries a [`driftless_model::thermal::ThermalPoly`] for compensation.
+//! * [`stats`]: Student-t and normal quantiles for the intervals.
+//!
+//! Algorithms only: no file I/O here.
+
+pub mod fit;
+pub mod stats;
+
+pub use fit::{
+    BIC_PARSIMONY, BandPoint, CrossValidation, FitOptions, NoiseScale, OrderAdvice, OrderRow,
+    ThermalFit, ThermalFitError, advise_order, cross_validate, fit,
+};
