@@ -15,7 +15,6 @@ use crate::allan::ci::chi2::{ln_gamma, normal_quantile as acklam};
 
 /// Continued fraction of the incomplete beta function (NR `betacf`, modified Lentz).
 fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
-    const TINY: f64 = 1e-300;
     let qab = a + b;
     let qap = a + 1.0;
     let qam = a - 1.0;
@@ -29,28 +28,13 @@ fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
     for m in 1..=500 {
         let m = m as f64;
         let m2 = 2.0 * m;
-        let aa = m * (b - m) * x / ((qam + m2) * (a + m2));
-        d = 1.0 + aa * d;
-        if d.abs() < TINY {
-            d = TINY;
-        }
-        c = 1.0 + aa / c;
-        if c.abs() < TINY {
-            c = TINY;
-        }
-        d = 1.0 / d;
-        h *= d * c;
-        let aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
-        d = 1.0 + aa * d;
-        if d.abs() < TINY {
-            d = TINY;
-        }
-        c = 1.0 + aa / c;
-        if c.abs() < TINY {
-            c = TINY;
-        }
-        d = 1.0 / d;
-        let del = d * c;
+        // even and odd terms of the fraction, each one modified-Lentz step
+        h *= lentz_step(m * (b - m) * x / ((qam + m2) * (a + m2)), &mut c, &mut d);
+        let del = lentz_step(
+            -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2)),
+            &mut c,
+            &mut d,
+        );
         h *= del;
         if (del - 1.0).abs() < 1e-16 {
             break;
@@ -129,6 +113,25 @@ pub fn normal_quantile(p: f64) -> f64 {
         return f64::NAN;
     }
     acklam(p)
+}
+
+/// Floor of |C| and |D| in the modified Lentz method.
+const TINY: f64 = 1e-300;
+
+/// One modified-Lentz step with partial numerator `aa` (denominator 1): updates C and D
+/// and returns their product, the factor of the convergent (Press et al., *Numerical
+/// Recipes*, 3rd ed., §5.2).
+fn lentz_step(aa: f64, c: &mut f64, d: &mut f64) -> f64 {
+    *d = 1.0 + aa * *d;
+    if d.abs() < TINY {
+        *d = TINY;
+    }
+    *c = 1.0 + aa / *c;
+    if c.abs() < TINY {
+        *c = TINY;
+    }
+    *d = 1.0 / *d;
+    *d * *c
 }
 
 #[cfg(test)]
