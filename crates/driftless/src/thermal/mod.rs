@@ -7,10 +7,13 @@
 //!   band, leave-one-temperature-out cross-validation and AIC/BIC order advice. Its
 //!   result carries a [`driftless_model::thermal::ThermalPoly`] for compensation.
 //! * [`stats`]: Student-t and normal quantiles for the intervals.
+//! * [`soak`]: the soak method — six-position + rate-table calibration at every set
+//!   temperature of a chamber recording, then a weighted fit of each bias and scale series.
 //!
 //! Algorithms only: no file I/O here.
 
 pub mod fit;
+pub mod soak;
 pub mod stats;
 
 pub use fit::{

@@ -1,0 +1,174 @@
+//! The soak method (issue 6 deliverable 1; seed paper §3.3): at every set temperature of
+//! a chamber recording, a six-position + rate-table calibration
+//! ([`crate::calib::six_position`]) gives each axis's bias b_k(T) and scale factor
+//! A_kk(T) with their standard errors; each series is then fitted by a polynomial in
+//! T − T_ref ([`super::fit`]), weighted by those errors.
+//!
+//! Quantities per axis k, from the forward model raw = A·x + b of each temperature:
+//! * bias b_k(T), raw units;
+//! * scale factor A_kk(T): for raw data already in SI this is 1 + s_k(T), s the
+//!   scale-factor error of the seed paper's eq. 2; for counts it is counts per SI unit.
+//!
+//! σ(A_kk) is propagated from the covariance of M = A⁻¹ reported by the calibration:
+//! dA = −A·dM·A, so ∂A_kk/∂M_ij = −A_ki·A_jk.
+//!
+//! The temperature of each point is the set temperature (the protocol soaks until the
+//! sensor has settled; the manifest's soak is sized for that).
+
+use super::fit::{FitOptions, ThermalFit, ThermalFitError, fit};
+use crate::calib::six_position::{
+    SixPositionError, SixPositionInput, SixPositionOptions, TriadEstimate, calibrate,
+};
+use crate::sim::chamber_manifest::ChamberManifest;
+
+/// Why a soak calibration failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SoakError {
+    /// The manifest has fewer set temperatures than the fit needs.
+    #[error("{found} set temperatures in the manifest; an order-{order} fit needs at least {}", order + 2)]
+    TooFewTemperatures {
+        /// Distinct set temperatures.
+        found: usize,
+        /// Polynomial order asked for.
+        order: usize,
+    },
+    /// The six-position calibration at one temperature failed.
+    #[error("at {t_c} °C: {source}")]
+    Calibration {
+        /// Set temperature.
+        t_c: f64,
+        /// Cause.
+        source: SixPositionError,
+    },
+    /// A polynomial fit failed.
+    #[error("{what}: {source}")]
+    Fit {
+        /// Which series.
+        what: String,
+        /// Cause.
+        source: ThermalFitError,
+    },
+}
+
+/// One fitted series: its points and the polynomial.
+#[derive(Clone, Debug)]
+pub struct SeriesFit {
+    /// `accel` or `gyro`.
+    pub triad: &'static str,
+    /// `bias` or `scale`.
+    pub quantity: &'static str,
+    /// Axis 0, 1, 2 (x, y, z).
+    pub axis: usize,
+    /// Values per temperature.
+    pub values: Vec<f64>,
+    /// Their standard errors.
+    pub sigma: Vec<f64>,
+    /// The fit.
+    pub fit: ThermalFit,
+}
+
+/// Result of [`soak_calibration`].
+#[derive(Clone, Debug)]
+pub struct SoakCalibration {
+    /// Set temperatures, ascending, °C.
+    pub temperatures_c: Vec<f64>,
+    /// 12 series: accel bias x/y/z, accel scale x/y/z, gyro bias x/y/z, gyro scale x/y/z.
+    pub series: Vec<SeriesFit>,
+}
+
+impl SoakCalibration {
+    /// The series of `triad` / `quantity` / `axis`.
+    pub fn get(&self, triad: &str, quantity: &str, axis: usize) -> Option<&SeriesFit> {
+        self.series
+            .iter()
+            .find(|s| s.triad == triad && s.quantity == quantity && s.axis == axis)
+    }
+}
+
+/// σ of the diagonal of A = M⁻¹ from the covariance of (vec M, b) (module docs).
+fn scale_sigma(est: &TriadEstimate) -> [f64; 3] {
+    let a = est.forward_matrix.0;
+    std::array::from_fn(|k| {
+        // gradient of A_kk w.r.t. vec(M): −A_ki·A_jk at index 3i + j
+        let g: Vec<f64> = (0..9).map(|p| -a[k][p / 3] * a[p % 3][k]).collect();
+        let mut v = 0.0;
+        for (r, gr) in g.iter().enumerate() {
+            for (c, gc) in g.iter().enumerate() {
+                v += gr * est.covariance[r * 12 + c] * gc;
+            }
+        }
+        v.max(0.0).sqrt()
+    })
+}
+
+/// Six-position calibration at every set temperature of `manifest` (sample columns as
+/// for [`SixPositionInput::from_manifest_columns`]), then a polynomial fit of every bias
+/// and scale series weighted by its standard errors.
+pub fn soak_calibration(
+    manifest: &ChamberManifest,
+    accel: &[Vec<f64>; 3],
+    gyro: &[Vec<f64>; 3],
+    scale: f64,
+    six: &SixPositionOptions,
+    fit_opts: &FitOptions,
+) -> Result<SoakCalibration, SoakError> {
+    let mut temps: Vec<f64> = manifest
+        .segments
+        .iter()
+        .map(|s| s.set_temperature_c)
+        .collect();
+    temps.sort_by(f64::total_cmp);
+    temps.dedup();
+    if temps.len() < fit_opts.order + 2 {
+        return Err(SoakError::TooFewTemperatures {
+            found: temps.len(),
+            order: fit_opts.order,
+        });
+    }
+    // per temperature: (accel, gyro) estimates
+    let mut ests = Vec::with_capacity(temps.len());
+    for &t in &temps {
+        let input = SixPositionInput::from_manifest_columns(manifest, accel, gyro, scale, t)
+            .map_err(|source| SoakError::Calibration { t_c: t, source })?;
+        let cal =
+            calibrate(&input, six).map_err(|source| SoakError::Calibration { t_c: t, source })?;
+        ests.push((cal.accel, cal.gyro));
+    }
+    let mut series = Vec::with_capacity(12);
+    for (triad, pick) in [("accel", 0usize), ("gyro", 1usize)] {
+        let get =
+            |e: &(TriadEstimate, TriadEstimate)| if pick == 0 { e.0.clone() } else { e.1.clone() };
+        for quantity in ["bias", "scale"] {
+            for axis in 0..3 {
+                let (mut values, mut sigma) = (Vec::new(), Vec::new());
+                for e in &ests {
+                    let est = get(e);
+                    if quantity == "bias" {
+                        values.push(est.calibration.bias[axis]);
+                        sigma.push(est.bias_sigma()[axis]);
+                    } else {
+                        values.push(est.forward_matrix.0[axis][axis]);
+                        sigma.push(scale_sigma(&est)[axis]);
+                    }
+                }
+                let what = format!("{triad} {quantity} {}", ["x", "y", "z"][axis]);
+                // A zero σ (noise-free data) cannot weight a fit: use unit weights then.
+                let weights = sigma.iter().all(|s| *s > 0.0).then_some(sigma.as_slice());
+                let f = fit(&temps, &values, weights, fit_opts)
+                    .map_err(|source| SoakError::Fit { what, source })?;
+                series.push(SeriesFit {
+                    triad,
+                    quantity,
+                    axis,
+                    values,
+                    sigma,
+                    fit: f,
+                });
+            }
+        }
+    }
+    Ok(SoakCalibration {
+        temperatures_c: temps,
+        series,
+    })
+}
