@@ -10,7 +10,8 @@
 //! walk (1.3e-4 m/s²/√s, ≈ 2 mg over the 5.2-h protocol) and slow bias instability move
 //! the bias between and within temperature steps by ~0.5–1 % of the swing, and the
 //! output quantization of a constant input adds a ~1e-3 m/s² offset; neither is in the
-//! six-position σ.
+//! six-position σ (rescaling the fit's σ by its χ²/dof does not help: 70.4 % — the
+//! drift is correlated across temperatures, not scatter).
 
 use driftless::calib::six_position::SixPositionOptions;
 use driftless::sim::chamber::ChamberConfig;
