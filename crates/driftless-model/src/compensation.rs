@@ -671,6 +671,65 @@ pub fn room_calibration_from_forward(
     })
 }
 
+/// Streaming per-sample compensation, as on a device: one call per sample, the effective
+/// calibration at the last temperature reading cached, so the polynomials are evaluated
+/// only when the reading changes (temperature moves slowly; sensors report it quantised).
+/// Results equal [`CompensationModel::compensate`] / [`CompensationModel::compensate_f32`]
+/// bit for bit.
+#[derive(Clone, Debug)]
+pub struct Compensator<'a> {
+    model: &'a CompensationModel,
+    last_bits: Option<u64>,
+    cal: ImuCalibration,
+    last_bits32: Option<u32>,
+    cal32: [Triad32; 2],
+}
+
+impl<'a> Compensator<'a> {
+    /// A compensator with an empty cache.
+    pub fn new(model: &'a CompensationModel) -> Compensator<'a> {
+        Compensator {
+            model,
+            last_bits: None,
+            cal: model.calibration,
+            last_bits32: None,
+            cal32: [Triad32::from_f64(&model.calibration.gyro); 2],
+        }
+    }
+
+    /// [`CompensationModel::compensate`] with the cached factors.
+    pub fn compensate(
+        &mut self,
+        gyro_raw: Vec3,
+        accel_raw: Vec3,
+        t_c: f64,
+    ) -> Result<(Vec3, Vec3), CompensationError> {
+        if self.last_bits != Some(t_c.to_bits()) {
+            self.cal = self.model.calibration_at(t_c)?;
+            self.last_bits = Some(t_c.to_bits());
+        }
+        Ok((
+            self.cal.gyro.apply(gyro_raw),
+            self.cal.accel.apply(accel_raw),
+        ))
+    }
+
+    /// [`CompensationModel::compensate_f32`] with the cached factors.
+    pub fn compensate_f32(
+        &mut self,
+        gyro_raw: [f32; 3],
+        accel_raw: [f32; 3],
+        t_c: f32,
+    ) -> Result<([f32; 3], [f32; 3]), CompensationError> {
+        if self.last_bits32 != Some(t_c.to_bits()) {
+            self.cal32 = self.model.calibration_at_f32(t_c)?;
+            self.last_bits32 = Some(t_c.to_bits());
+        }
+        let [g, a] = &self.cal32;
+        Ok((g.apply(gyro_raw), a.apply(accel_raw)))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1050,5 +1109,26 @@ mod tests {
                 model_id: 0xD1F7
             })
         );
+    }
+
+    #[test]
+    fn compensator_equals_the_model_bit_for_bit() {
+        let (m, _, _) = model(OutOfRange::Clamp);
+        let mut c = Compensator::new(&m);
+        for (k, t) in [25.0, 25.0, 31.5, 31.5, -20.0, 60.0, 60.0]
+            .into_iter()
+            .enumerate()
+        {
+            let g = [0.1 * k as f64, -0.02, 0.3];
+            let a = [0.5, -9.8 + 0.01 * k as f64, 0.2];
+            assert_eq!(c.compensate(g, a, t), m.compensate(g, a, t));
+            let g32 = g.map(|v| v as f32);
+            let a32 = a.map(|v| v as f32);
+            assert_eq!(
+                c.compensate_f32(g32, a32, t as f32),
+                m.compensate_f32(g32, a32, t as f32)
+            );
+        }
+        assert!(c.compensate([0.0; 3], [0.0; 3], f64::NAN).is_err());
     }
 }

@@ -129,6 +129,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         });
         report(&format!("f64 per-sample, {label}"), s);
     }
+    // Streaming per-sample f64 (cached factors for the last temperature).
+    for (label, t) in [
+        ("quantised T", &t_quant),
+        ("every sample distinct", &t_dist),
+    ] {
+        let mut og = vec![[0.0; 3]; n];
+        let mut oa = vec![[0.0; 3]; n];
+        let s = best(|| {
+            let mut c = driftless_model::compensation::Compensator::new(&m);
+            let t0 = Instant::now();
+            for i in 0..n {
+                let (g, a) = c
+                    .compensate(black_box(gyro[i]), black_box(accel[i]), t[i])
+                    .expect("in range");
+                og[i] = g;
+                oa[i] = a;
+            }
+            black_box((&og, &oa));
+            t0.elapsed().as_secs_f64()
+        });
+        report(&format!("f64 streaming Compensator, {label}"), s);
+    }
     // Block f64.
     for (label, t) in [
         ("quantised T", &t_quant),
@@ -163,6 +185,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             t0.elapsed().as_secs_f64()
         });
         report(&format!("f32 per-sample, {label}"), s);
+    }
+    // Streaming per-sample f32.
+    for (label, t) in [("quantised T", &tq32), ("every sample distinct", &td32)] {
+        let mut og = vec![[0.0f32; 3]; n];
+        let mut oa = vec![[0.0f32; 3]; n];
+        let s = best(|| {
+            let mut c = driftless_model::compensation::Compensator::new(&m);
+            let t0 = Instant::now();
+            for i in 0..n {
+                let (g, a) = c
+                    .compensate_f32(black_box(g32[i]), black_box(a32[i]), t[i])
+                    .expect("in range");
+                og[i] = g;
+                oa[i] = a;
+            }
+            black_box((&og, &oa));
+            t0.elapsed().as_secs_f64()
+        });
+        report(&format!("f32 streaming Compensator, {label}"), s);
     }
     // Block f32.
     let mut bg32 = g32.clone();
