@@ -40,6 +40,9 @@ pub enum SoakError {
         /// Cause.
         source: SixPositionError,
     },
+    /// The compensation model could not be built.
+    #[error("compensation model: {0}")]
+    Model(String),
     /// A polynomial fit failed.
     #[error("{what}: {source}")]
     Fit {
@@ -72,11 +75,101 @@ pub struct SeriesFit {
 pub struct SoakCalibration {
     /// Set temperatures, ascending, °C.
     pub temperatures_c: Vec<f64>,
+    /// The six-position estimates (accelerometer, gyro) at each set temperature.
+    pub estimates: Vec<(TriadEstimate, TriadEstimate)>,
     /// 12 series: accel bias x/y/z, accel scale x/y/z, gyro bias x/y/z, gyro scale x/y/z.
     pub series: Vec<SeriesFit>,
 }
 
 impl SoakCalibration {
+    /// The real-time compensation model ([`driftless_model::compensation`]): the room
+    /// calibration at T_ref — M from the six-position estimate at the set temperature
+    /// nearest T_ref, b from the bias fits' value at T_ref — and the thermal deltas of
+    /// the fits, Δb(T) = b(T) − b(T_ref), Δs(T) = (A_kk(T) − A_kk(T_ref))/A_kk(T_ref),
+    /// valid over the soaked range.
+    pub fn compensation_model(
+        &self,
+        id: u64,
+        policy: driftless_model::compensation::OutOfRange,
+    ) -> Result<driftless_model::compensation::CompensationModel, SoakError> {
+        use driftless_model::calib::{ImuCalibration, TriadCalibration};
+        use driftless_model::compensation::{CompensationModel, TriadThermal};
+        use driftless_model::thermal::ThermalPoly;
+        let invalid =
+            |e: driftless_model::compensation::CompensationError| SoakError::Model(e.to_string());
+        let t_ref = self.series[0].fit.t_ref_c();
+        let nearest = (0..self.temperatures_c.len())
+            .min_by(|&a, &b| {
+                (self.temperatures_c[a] - t_ref)
+                    .abs()
+                    .total_cmp(&(self.temperatures_c[b] - t_ref).abs())
+            })
+            .ok_or_else(|| SoakError::Model("no temperatures".into()))?;
+        let mut triads = Vec::with_capacity(2);
+        let mut rooms = Vec::with_capacity(2);
+        for (t, triad) in ["accel", "gyro"].iter().enumerate() {
+            let mut bias = [ThermalPoly::constant(0.0); 3];
+            let mut scale = [ThermalPoly::constant(0.0); 3];
+            let mut b_ref = [0.0; 3];
+            for axis in 0..3 {
+                let sb = self
+                    .get(triad, "bias", axis)
+                    .ok_or_else(|| SoakError::Model(format!("{triad} bias {axis} missing")))?;
+                let ss = self
+                    .get(triad, "scale", axis)
+                    .ok_or_else(|| SoakError::Model(format!("{triad} scale {axis} missing")))?;
+                bias[axis] = sb.fit.poly;
+                b_ref[axis] = sb.fit.eval(t_ref);
+                // s(T) = A_kk(T) − 1 as a polynomial: the fit with c₀ − 1
+                let (lo, hi) = ss.fit.range_c();
+                let mut c = *ss.fit.poly.coeffs();
+                c[0] -= 1.0;
+                scale[axis] = ThermalPoly::new(t_ref, &c, lo, hi)
+                    .map_err(|e| SoakError::Model(format!("{triad} scale {axis}: {e}")))?;
+            }
+            triads.push(TriadThermal::from_forward(&bias, &scale).map_err(invalid)?);
+            let est = if t == 0 {
+                &self.estimates[nearest].0
+            } else {
+                &self.estimates[nearest].1
+            };
+            rooms.push(TriadCalibration {
+                bias: b_ref,
+                matrix: est.calibration.matrix,
+            });
+        }
+        let range = [
+            self.temperatures_c[0],
+            self.temperatures_c[self.temperatures_c.len() - 1],
+        ];
+        // The six-position M at the nearest temperature already holds that temperature's
+        // scale; refer it to T_ref: M_ref = M_near · diag(A_kk(T_near) / A_kk(T_ref)).
+        let t_near = self.temperatures_c[nearest];
+        for (t, triad) in ["accel", "gyro"].iter().enumerate() {
+            for axis in 0..3 {
+                let f = self
+                    .get(triad, "scale", axis)
+                    .map(|s| s.fit.eval(t_near) / s.fit.eval(t_ref))
+                    .unwrap_or(1.0);
+                for r in 0..3 {
+                    rooms[t].matrix.0[r][axis] *= f;
+                }
+            }
+        }
+        CompensationModel::new(
+            id,
+            ImuCalibration {
+                accel: rooms[0],
+                gyro: rooms[1],
+            },
+            Some(triads[1]),
+            Some(triads[0]),
+            range,
+            policy,
+        )
+        .map_err(invalid)
+    }
+
     /// The series of `triad` / `quantity` / `axis`.
     pub fn get(&self, triad: &str, quantity: &str, axis: usize) -> Option<&SeriesFit> {
         self.series
@@ -169,6 +262,7 @@ pub fn soak_calibration(
     }
     Ok(SoakCalibration {
         temperatures_c: temps,
+        estimates: ests,
         series,
     })
 }
