@@ -231,4 +231,25 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
         100.0 * rc / rr
     );
     assert!(all_terms || rc <= 0.05 * rr, "{rc} vs {rr}");
+
+    // The model file round trip: the same compensation, bit for bit.
+    use driftless::thermal::model_file::ThermalModelFile;
+    let path = std::env::temp_dir().join(format!("driftless-thermal-{}.toml", std::process::id()));
+    ThermalModelFile::from_model(&model, ["m/s^2", "rad/s"])
+        .save(&path)
+        .expect("save");
+    let (_, back) = ThermalModelFile::load(&path).expect("load");
+    for t in [-30.0, -25.0, 3.3, 25.0, 47.1, 70.0, 80.0] {
+        let x = ([0.01, -0.02, 0.03], [0.5, -9.7, 0.2]);
+        assert_eq!(
+            back.compensate(x.0, x.1, t),
+            model.compensate(x.0, x.1, t),
+            "{t} °C"
+        );
+    }
+    let text = std::fs::read_to_string(&path).expect("read");
+    std::fs::write(&path, text.replace("\"clamp\"", "\"wrap\"")).expect("write");
+    let e = ThermalModelFile::load(&path).unwrap_err().to_string();
+    assert!(e.contains("out_of_range") && e.contains("wrap"), "{e}");
+    let _ = std::fs::remove_file(&path);
 }

@@ -7,12 +7,14 @@
 //!   band, leave-one-temperature-out cross-validation and AIC/BIC order advice. Its
 //!   result carries a [`driftless_model::thermal::ThermalPoly`] for compensation.
 //! * [`stats`]: Student-t and normal quantiles for the intervals.
+//! * [`model_file`]: the thermal compensation model file (TOML).
 //! * [`soak`]: the soak method — six-position + rate-table calibration at every set
 //!   temperature of a chamber recording, then a weighted fit of each bias and scale series.
 //!
 //! Algorithms only: no file I/O here.
 
 pub mod fit;
+pub mod model_file;
 pub mod soak;
 pub mod stats;
 
