@@ -13,6 +13,7 @@ mod input;
 mod nav_cmd;
 mod output;
 mod simulate_cmd;
+mod thermal_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -42,6 +43,9 @@ enum Command {
     Bench(bench_cmd::BenchArgs),
     /// Loosely coupled GNSS/INS on recorded data, with simulated GNSS outages.
     Nav(nav_cmd::NavArgs),
+    /// Thermal calibration: soak (chamber) data → bias and scale-factor polynomials and
+    /// the real-time compensation model.
+    Thermal(thermal_cmd::ThermalArgs),
     /// Simulate IMU, GNSS and truth from a scenario file (trajectory, sensor errors,
     /// temperature, GNSS).
     Simulate(simulate_cmd::SimulateArgs),
@@ -59,6 +63,7 @@ fn main() -> ExitCode {
         Command::Bench(a) => bench_cmd::run(a),
         Command::Nav(a) => nav_cmd::run(a),
         Command::Simulate(a) => simulate_cmd::run(a),
+        Command::Thermal(a) => thermal_cmd::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -53,7 +53,8 @@ pub struct TriadSection {
 pub struct ThermalModelFile {
     /// [`FORMAT_VERSION`].
     pub format_version: u32,
-    /// Identifies the model (recorded in the stamp of compensated output).
+    /// Identifies the model (recorded in the stamp of compensated output); < 2⁶³, as
+    /// TOML integers are signed 64-bit.
     pub model_id: u64,
     /// T_ref, °C.
     pub t_ref_c: f64,
