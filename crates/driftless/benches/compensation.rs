@@ -12,7 +12,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use driftless_model::calib::{ImuCalibration, TriadCalibration};
-use driftless_model::compensation::{CompensationModel, OutOfRange, TriadThermal};
+use driftless_model::compensation::{CompensationModel, Compensator, OutOfRange, TriadThermal};
 use driftless_model::linalg::Mat3;
 use driftless_model::thermal::ThermalPoly;
 
@@ -68,6 +68,26 @@ fn best(mut f: impl FnMut() -> f64) -> f64 {
     (0..REPS).map(|_| f()).fold(f64::INFINITY, f64::min)
 }
 
+/// Best time of a per-sample loop: `setup` makes fresh per-repetition state (e.g. a
+/// `Compensator` with an empty cache), `step(state, i)` compensates sample `i` and
+/// returns its output, which is kept so that nothing is optimised away.
+fn per_sample<S, O: Default + Clone>(
+    n: usize,
+    mut setup: impl FnMut() -> S,
+    mut step: impl FnMut(&mut S, usize) -> O,
+) -> f64 {
+    let mut out = vec![O::default(); n];
+    best(|| {
+        let mut state = setup();
+        let t0 = Instant::now();
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = step(&mut state, i);
+        }
+        black_box(&out);
+        t0.elapsed().as_secs_f64()
+    })
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let n: usize = args
@@ -108,25 +128,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     };
 
-    // Per-sample f64.
+    // Per-sample f64 (stateless).
     for (label, t) in [
         ("quantised T", &t_quant),
         ("every sample distinct", &t_dist),
     ] {
-        let mut og = vec![[0.0; 3]; n];
-        let mut oa = vec![[0.0; 3]; n];
-        let s = best(|| {
-            let t0 = Instant::now();
-            for i in 0..n {
-                let (g, a) = m
-                    .compensate(black_box(gyro[i]), black_box(accel[i]), t[i])
-                    .expect("in range");
-                og[i] = g;
-                oa[i] = a;
-            }
-            black_box((&og, &oa));
-            t0.elapsed().as_secs_f64()
-        });
+        let s = per_sample(
+            n,
+            || (),
+            |_, i| {
+                m.compensate(black_box(gyro[i]), black_box(accel[i]), t[i])
+                    .expect("in range")
+            },
+        );
         report(&format!("f64 per-sample, {label}"), s);
     }
     // Streaming per-sample f64 (cached factors for the last temperature).
@@ -134,21 +148,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("quantised T", &t_quant),
         ("every sample distinct", &t_dist),
     ] {
-        let mut og = vec![[0.0; 3]; n];
-        let mut oa = vec![[0.0; 3]; n];
-        let s = best(|| {
-            let mut c = driftless_model::compensation::Compensator::new(&m);
-            let t0 = Instant::now();
-            for i in 0..n {
-                let (g, a) = c
-                    .compensate(black_box(gyro[i]), black_box(accel[i]), t[i])
-                    .expect("in range");
-                og[i] = g;
-                oa[i] = a;
-            }
-            black_box((&og, &oa));
-            t0.elapsed().as_secs_f64()
-        });
+        let s = per_sample(
+            n,
+            || Compensator::new(&m),
+            |c, i| {
+                c.compensate(black_box(gyro[i]), black_box(accel[i]), t[i])
+                    .expect("in range")
+            },
+        );
         report(&format!("f64 streaming Compensator, {label}"), s);
     }
     // Block f64.
@@ -168,41 +175,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         });
         report(&format!("f64 block, {label}"), s);
     }
-    // Per-sample f32.
+    // Per-sample f32 (stateless).
     for (label, t) in [("quantised T", &tq32), ("every sample distinct", &td32)] {
-        let mut og = vec![[0.0f32; 3]; n];
-        let mut oa = vec![[0.0f32; 3]; n];
-        let s = best(|| {
-            let t0 = Instant::now();
-            for i in 0..n {
-                let (g, a) = m
-                    .compensate_f32(black_box(g32[i]), black_box(a32[i]), t[i])
-                    .expect("in range");
-                og[i] = g;
-                oa[i] = a;
-            }
-            black_box((&og, &oa));
-            t0.elapsed().as_secs_f64()
-        });
+        let s = per_sample(
+            n,
+            || (),
+            |_, i| {
+                m.compensate_f32(black_box(g32[i]), black_box(a32[i]), t[i])
+                    .expect("in range")
+            },
+        );
         report(&format!("f32 per-sample, {label}"), s);
     }
     // Streaming per-sample f32.
     for (label, t) in [("quantised T", &tq32), ("every sample distinct", &td32)] {
-        let mut og = vec![[0.0f32; 3]; n];
-        let mut oa = vec![[0.0f32; 3]; n];
-        let s = best(|| {
-            let mut c = driftless_model::compensation::Compensator::new(&m);
-            let t0 = Instant::now();
-            for i in 0..n {
-                let (g, a) = c
-                    .compensate_f32(black_box(g32[i]), black_box(a32[i]), t[i])
-                    .expect("in range");
-                og[i] = g;
-                oa[i] = a;
-            }
-            black_box((&og, &oa));
-            t0.elapsed().as_secs_f64()
-        });
+        let s = per_sample(
+            n,
+            || Compensator::new(&m),
+            |c, i| {
+                c.compensate_f32(black_box(g32[i]), black_box(a32[i]), t[i])
+                    .expect("in range")
+            },
+        );
         report(&format!("f32 streaming Compensator, {label}"), s);
     }
     // Block f32.
