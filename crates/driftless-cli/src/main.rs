@@ -7,6 +7,7 @@
 mod allan_cmd;
 mod bench_cmd;
 mod calibrate_cmd;
+mod compensate_cmd;
 mod convert_cmd;
 mod demo_cmd;
 mod input;
@@ -37,6 +38,8 @@ enum Command {
     /// Room-temperature calibration (bias, scale, misalignment with σ): six-position +
     /// rate table, or multi-position without fixtures.
     Calibrate(calibrate_cmd::CalibrateArgs),
+    /// Apply a thermal compensation model to a log (refuses a log compensated already).
+    Compensate(compensate_cmd::CompensateArgs),
     /// Convert a delimited text log to the compact binary log format (or back).
     Convert(convert_cmd::ConvertArgs),
     /// Speed benchmarks (parse, binary read, exact and fast OADEV) on generated data.
@@ -59,6 +62,7 @@ fn main() -> ExitCode {
         Command::Allan(a) => allan_cmd::run(a),
         Command::Convert(a) => convert_cmd::run(a),
         Command::Calibrate(a) => calibrate_cmd::run(a),
+        Command::Compensate(a) => compensate_cmd::run(a),
         Command::Demo(a) => demo_cmd::run(a),
         Command::Bench(a) => bench_cmd::run(a),
         Command::Nav(a) => nav_cmd::run(a),
