@@ -8,6 +8,8 @@
 //!   result carries a [`driftless_model::thermal::ThermalPoly`] for compensation.
 //! * [`stats`]: Student-t and normal quantiles for the intervals.
 //! * [`model_file`]: the thermal compensation model file (TOML).
+//! * [`ramp`]: the ramp method — bias versus temperature from one warm-up or cool-down,
+//!   binned medians (robust to quantised temperature and uneven heating), hysteresis.
 //! * [`soak`]: the soak method — six-position + rate-table calibration at every set
 //!   temperature of a chamber recording, then a weighted fit of each bias and scale series.
 //!
@@ -15,6 +17,7 @@
 
 pub mod fit;
 pub mod model_file;
+pub mod ramp;
 pub mod soak;
 pub mod stats;
 
