@@ -26,6 +26,29 @@ pub struct ThermalArgs {
 pub enum ThermalMethod {
     /// Chamber (soak) recording + segment manifest → thermal model.
     Soak(SoakArgs),
+    /// Bias versus temperature from one warm-up or cool-down of a static sensor.
+    Ramp(RampArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct RampArgs {
+    /// Static log: time, gyro and/or accelerometer columns with units, one temperature
+    /// column (°C).
+    pub log: PathBuf,
+    /// Polynomial order, 1–5.
+    #[arg(long, default_value_t = 3)]
+    pub order: usize,
+    /// Reference temperature, °C.
+    #[arg(long, default_value_t = 25.0, allow_hyphen_values = true)]
+    pub t_ref: f64,
+    /// Temperature bin width, °C.
+    #[arg(long, default_value_t = 1.0)]
+    pub bin: f64,
+    /// Machine-readable output.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub input: InputArgs,
 }
 
 #[derive(Args, Debug)]
@@ -61,6 +84,7 @@ pub struct SoakArgs {
 pub fn run(a: ThermalArgs) -> Result<()> {
     match a.method {
         ThermalMethod::Soak(s) => soak(s),
+        ThermalMethod::Ramp(r) => ramp(r),
     }
 }
 
@@ -186,5 +210,104 @@ fn soak(s: SoakArgs) -> Result<()> {
     for p in [&s.out, &s.plot].into_iter().flatten() {
         println!("wrote {}", p.display());
     }
+    Ok(())
+}
+
+fn ramp(r: RampArgs) -> Result<()> {
+    use driftless::thermal::ramp::{RampOptions, ramp_calibration};
+    let mut input = r.input.clone();
+    input.time_column.get_or_insert_with(|| "1".into());
+    let log = input.read(&r.log)?;
+    let Some(time) = log.time_s.as_deref() else {
+        anyhow::bail!("{}: no time column", r.log.display());
+    };
+    let Some(temp) = log
+        .channels
+        .iter()
+        .find(|c| c.quantity == Quantity::Temperature)
+    else {
+        anyhow::bail!(
+            "{}: no temperature column (a column with unit degC, or `--column N:degC`)",
+            r.log.display()
+        );
+    };
+    let chans: Vec<(&str, &[f64])> = log
+        .channels
+        .iter()
+        .filter(|c| matches!(c.quantity, Quantity::AngularRate | Quantity::SpecificForce))
+        .map(|c| (c.name.as_str(), c.values.as_slice()))
+        .collect();
+    if chans.is_empty() {
+        anyhow::bail!(
+            "{}: no angular-rate or specific-force column with a unit",
+            r.log.display()
+        );
+    }
+    let opts = RampOptions {
+        bin_c: r.bin,
+        fit: FitOptions {
+            order: r.order,
+            t_ref_c: r.t_ref,
+            ..FitOptions::default()
+        },
+        ..RampOptions::default()
+    };
+    let res = ramp_calibration(time, &temp.values, &chans, &opts)
+        .with_context(|| format!("{}", r.log.display()))?;
+    let heating = res.points.iter().filter(|p| p.heating).count();
+    if r.json {
+        let fits: Vec<serde_json::Value> = res
+            .names
+            .iter()
+            .zip(&res.fits)
+            .enumerate()
+            .map(|(k, (n, f))| {
+                serde_json::json!({
+                    "channel": n, "coefficients": f.coeffs, "std_errors": f.std_errors,
+                    "residual_rms": f.residual_rms,
+                    "hysteresis_rms": res.hysteresis.as_ref().map(|h| h[k]),
+                })
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "bins_heating": heating,
+                "bins_cooling": res.points.len() - heating,
+                "t_ref_c": r.t_ref,
+                "order": r.order,
+                "fits": fits,
+            }))?
+        );
+        return Ok(());
+    }
+    println!(
+        "{} temperature bins ({heating} heating, {} cooling); order {} about {} °C",
+        res.points.len(),
+        res.points.len() - heating,
+        r.order,
+        r.t_ref
+    );
+    let mut head = vec!["channel".to_string()];
+    head.extend((0..=r.order).map(|k| format!("c{k} ± σ")));
+    head.push("hysteresis RMS".into());
+    let mut tab = crate::output::Table::new(head);
+    for (k, (n, f)) in res.names.iter().zip(&res.fits).enumerate() {
+        let mut row = vec![n.clone()];
+        for (c, e) in f.coeffs.iter().zip(&f.std_errors) {
+            row.push(format!(
+                "{} ± {}",
+                crate::output::sci(*c),
+                crate::output::sci(*e)
+            ));
+        }
+        row.push(
+            res.hysteresis
+                .as_ref()
+                .map_or("–".into(), |h| crate::output::sci(h[k])),
+        );
+        tab.row(row);
+    }
+    print!("{}", tab.render());
     Ok(())
 }
