@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 mod common;
-use common::{bin, run_json};
+use common::{bin, run_json, simulate};
 
 fn matrix(v: &serde_json::Value) -> [[f64; 3]; 3] {
     std::array::from_fn(|r| std::array::from_fn(|c| v[r][c].as_f64().unwrap()))
@@ -18,13 +18,7 @@ fn six_position_on_a_simulated_chamber_run() {
     let scenario = "seed = 4\n[imu]\nrate_hz = 100.0\npreset = \"consumer\"\noutput = \"rates\"\n\
                     errors = \"deterministic\"\n[trajectory]\ntype = \"chamber\"\n\
                     temperatures_c = [25.0]\nsoak_s = 20.0\nposition_dwell_s = 10.0\n";
-    std::fs::write(dir.join("chamber.toml"), scenario).unwrap();
-    run_json(
-        bin()
-            .args(["simulate", "--json", "--out"])
-            .arg(dir.join("sim"))
-            .arg(dir.join("chamber.toml")),
-    );
+    simulate(&dir, "sim", scenario);
     let v = run_json(
         bin()
             .args(["calibrate", "six-position", "--json", "--g-sensitivity"])

@@ -3,7 +3,7 @@
 //! the order is a clear error.
 
 mod common;
-use common::{bin, run_json};
+use common::{bin, run_json, simulate};
 
 #[test]
 fn soak_on_a_simulated_chamber_run() {
@@ -14,13 +14,7 @@ fn soak_on_a_simulated_chamber_run() {
                     temperatures_c = [-20.0, 0.0, 25.0, 45.0, 70.0]\nsoak_s = 200.0\n\
                     lag_tau_s = 5.0\nposition_dwell_s = 5.0\nmove_s = 2.0\nrate_revolutions = 1\n\
                     spin_s = 1.0\n";
-    std::fs::write(dir.join("chamber.toml"), scenario).unwrap();
-    run_json(
-        bin()
-            .args(["simulate", "--json", "--out"])
-            .arg(dir.join("sim"))
-            .arg(dir.join("chamber.toml")),
-    );
+    simulate(&dir, "sim", scenario);
     let v = run_json(
         bin()
             .args(["thermal", "soak", "--json", "--manifest"])
@@ -76,33 +70,25 @@ fn compensate_a_warm_up_log() {
     std::fs::create_dir_all(&dir).unwrap();
     let head = "seed = 5\n[imu]\nrate_hz = 50.0\npreset = \"adi-like\"\noutput = \"rates\"\n\
                 errors = \"deterministic\"\n";
-    std::fs::write(
-        dir.join("chamber.toml"),
-        format!(
+    simulate(
+        &dir,
+        "chamber",
+        &format!(
             "{head}[trajectory]\ntype = \"chamber\"\n\
              temperatures_c = [15.0, 25.0, 35.0, 45.0, 55.0, 65.0]\nsoak_s = 60.0\n\
              lag_tau_s = 5.0\nposition_dwell_s = 5.0\nmove_s = 2.0\nrate_revolutions = 1\n\
              spin_s = 1.0\n"
         ),
-    )
-    .unwrap();
-    std::fs::write(
-        dir.join("warm.toml"),
-        format!(
+    );
+    simulate(
+        &dir,
+        "warm",
+        &format!(
             "{head}[trajectory]\ntype = \"static\"\nlat_deg = 51.08\nlon_deg = -114.13\n\
              height_m = 1100.0\nduration_s = 1800.0\n[temperature]\nkind = \"warm_up\"\n\
              t0_c = 25.0\nt1_c = 45.0\ntau_s = 300.0\n"
         ),
-    )
-    .unwrap();
-    for (s, o) in [("chamber.toml", "chamber"), ("warm.toml", "warm")] {
-        run_json(
-            bin()
-                .args(["simulate", "--json", "--out"])
-                .arg(dir.join(o))
-                .arg(dir.join(s)),
-        );
-    }
+    );
     run_json(
         bin()
             .args(["thermal", "soak", "--json", "--manifest"])
@@ -192,18 +178,12 @@ fn compensate_a_warm_up_log() {
 fn ramp_on_a_simulated_warm_up() {
     let dir = std::env::temp_dir().join(format!("driftless-ramp-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("ramp.toml"),
+    simulate(
+        &dir,
+        "sim",
         "seed = 3\n[imu]\nrate_hz = 200.0\npreset = \"consumer\"\noutput = \"rates\"\n\
          [trajectory]\ntype = \"static\"\nlat_deg = 45.0\nduration_s = 1200.0\n\
          [temperature]\nkind = \"warm_up\"\nt0_c = 20.0\nt1_c = 50.0\ntau_s = 300.0\n",
-    )
-    .unwrap();
-    run_json(
-        bin()
-            .args(["simulate", "--json", "--out"])
-            .arg(dir.join("sim"))
-            .arg(dir.join("ramp.toml")),
     );
     let v = run_json(
         bin()

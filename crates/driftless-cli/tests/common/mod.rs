@@ -18,3 +18,18 @@ pub fn run_json(cmd: &mut Command) -> serde_json::Value {
     );
     serde_json::from_slice(&out.stdout).unwrap()
 }
+
+/// Writes `scenario` to `dir/<name>.toml`, runs `driftless simulate` on it into
+/// `dir/<name>` and returns that folder.
+pub fn simulate(dir: &std::path::Path, name: &str, scenario: &str) -> std::path::PathBuf {
+    let file = dir.join(format!("{name}.toml"));
+    std::fs::write(&file, scenario).unwrap();
+    let out = dir.join(name);
+    run_json(
+        bin()
+            .args(["simulate", "--json", "--out"])
+            .arg(&out)
+            .arg(&file),
+    );
+    out
+}
