@@ -122,32 +122,33 @@ fn read(input: &InputArgs, path: &Path) -> Result<ImuLog> {
     input.read(path)
 }
 
-/// Three columns of `log` as vectors: by quantity when it has exactly three of it,
-/// else the channels at `first..first + 3`.
-fn triad(log: &ImuLog, q: Quantity, first: usize, what: &str) -> Result<Vec<Vec3>> {
-    let by_q: Vec<usize> = (0..log.channels.len())
-        .filter(|&i| log.channels[i].quantity == q)
-        .collect();
-    let idx: Vec<usize> = if by_q.len() == 3 {
-        by_q
-    } else {
-        (first..first + 3).collect()
-    };
-    if idx.iter().any(|&i| i >= log.channels.len()) {
+/// Three columns of `log`: by quantity when it has exactly three of it (units given),
+/// else the channels at `first..first + 3` (raw counts).
+fn triad_columns<'a>(
+    log: &'a ImuLog,
+    q: Quantity,
+    first: usize,
+    what: &str,
+) -> Result<[&'a [f64]; 3]> {
+    if let Some(t) = log.triad_of(q) {
+        return Ok(t);
+    }
+    if first + 3 > log.channels.len() {
         bail!(
             "{}: needs three {what} columns, found {} data columns",
             log.source,
             log.channels.len()
         );
     }
-    let c = |k: usize| &log.channels[idx[k]].values;
-    Ok((0..log.len())
-        .map(|i| [c(0)[i], c(1)[i], c(2)[i]])
-        .collect())
+    Ok(std::array::from_fn(|k| {
+        log.channels[first + k].values.as_slice()
+    }))
 }
 
-fn columns(v: &[Vec3]) -> [Vec<f64>; 3] {
-    std::array::from_fn(|k| v.iter().map(|x| x[k]).collect())
+/// [`triad_columns`] as one vector per sample.
+fn triad(log: &ImuLog, q: Quantity, first: usize, what: &str) -> Result<Vec<Vec3>> {
+    let c = triad_columns(log, q, first, what)?;
+    Ok((0..log.len()).map(|i| c.map(|col| col[i])).collect())
 }
 
 fn entry(
@@ -359,15 +360,9 @@ fn six(s: SixArgs) -> Result<()> {
             manifest.sample_rate_hz
         );
     }
-    let gyro = triad(&log, Quantity::AngularRate, 0, "gyro")?;
-    let accel = triad(&log, Quantity::SpecificForce, 3, "accelerometer")?;
-    let input = SixPositionInput::from_manifest_columns(
-        &manifest,
-        &columns(&accel),
-        &columns(&gyro),
-        1.0,
-        temp,
-    )?;
+    let gyro = triad_columns(&log, Quantity::AngularRate, 0, "gyro")?;
+    let accel = triad_columns(&log, Quantity::SpecificForce, 3, "accelerometer")?;
+    let input = SixPositionInput::from_manifest_columns(&manifest, accel, gyro, 1.0, temp)?;
     let mut opts = SixPositionOptions::from_manifest(&manifest);
     opts.estimate_g_sensitivity = s.g_sensitivity;
     if s.common.gravity.is_some() {

@@ -31,17 +31,18 @@ pub struct CompensateArgs {
     pub input: InputArgs,
 }
 
-/// The stamp an input carries, from its source line (text: first line; DRIFTLOG: the
-/// header's source).
+/// The stamp an input carries, from its source line (text: the first line, read from
+/// the first 4 KiB only; DRIFTLOG: the header's source).
 fn existing_stamp(path: &Path, log: &ImuLog) -> Option<String> {
-    let first = std::fs::read(path).ok().and_then(|b| {
-        let end = b
-            .iter()
-            .position(|&c| c == b'\n')
-            .unwrap_or(b.len())
-            .min(4096);
-        String::from_utf8(b[..end].to_vec()).ok()
-    });
+    use std::io::Read as _;
+    let mut head = Vec::with_capacity(4096);
+    let first = std::fs::File::open(path)
+        .and_then(|f| f.take(4096).read_to_end(&mut head))
+        .ok()
+        .map(|_| {
+            let end = head.iter().position(|&c| c == b'\n').unwrap_or(head.len());
+            String::from_utf8_lossy(&head[..end]).into_owned()
+        });
     [first.unwrap_or_default(), log.source.clone()]
         .into_iter()
         .find_map(|s| s.find(STAMP).map(|i| s[i..].trim().to_string()))
@@ -73,15 +74,10 @@ pub fn run(a: CompensateArgs) -> Result<()> {
             model.id()
         );
     }
-    let find = |q: Quantity| -> Vec<usize> {
-        (0..log.channels.len())
-            .filter(|&i| log.channels[i].quantity == q)
-            .collect()
-    };
     let (gi, ai, ti) = (
-        find(Quantity::AngularRate),
-        find(Quantity::SpecificForce),
-        find(Quantity::Temperature),
+        log.indices_of(Quantity::AngularRate),
+        log.indices_of(Quantity::SpecificForce),
+        log.indices_of(Quantity::Temperature),
     );
     if gi.len() != 3 || ai.len() != 3 {
         bail!(

@@ -102,18 +102,14 @@ fn soak(s: SoakArgs) -> Result<()> {
     let mut input = s.input.clone();
     input.time_column.get_or_insert_with(|| "1".into());
     let log = input.read(&s.log)?;
-    let pick = |q: Quantity, what: &str| -> Result<[Vec<f64>; 3]> {
-        let idx: Vec<usize> = (0..log.channels.len())
-            .filter(|&i| log.channels[i].quantity == q)
-            .collect();
-        if idx.len() != 3 {
-            anyhow::bail!(
+    let pick = |q: Quantity, what: &str| -> Result<[&[f64]; 3]> {
+        log.triad_of(q).ok_or_else(|| {
+            anyhow::anyhow!(
                 "{}: needs three {what} columns with units (found {})",
                 s.log.display(),
-                idx.len()
-            );
-        }
-        Ok(std::array::from_fn(|k| log.channels[idx[k]].values.clone()))
+                log.indices_of(q).len()
+            )
+        })
     };
     let gyro = pick(Quantity::AngularRate, "angular-rate")?;
     let accel = pick(Quantity::SpecificForce, "specific-force")?;
@@ -124,7 +120,7 @@ fn soak(s: SoakArgs) -> Result<()> {
     };
     let six = SixPositionOptions::from_manifest(&manifest);
     let t = std::time::Instant::now();
-    let soak = soak_calibration(&manifest, &accel, &gyro, 1.0, &six, &fit_opts)?;
+    let soak = soak_calibration(&manifest, accel, gyro, 1.0, &six, &fit_opts)?;
     // A model id from the coefficients (stable for the same fit; < 2⁶³: TOML integers
     // are signed 64-bit).
     let id = soak

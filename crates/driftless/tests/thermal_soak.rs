@@ -104,8 +104,8 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
     let t1 = std::time::Instant::now();
     let soak = soak_calibration(
         &proto.manifest,
-        &out.accel,
-        &out.gyro,
+        out.accel.each_ref().map(Vec::as_slice),
+        out.gyro.each_ref().map(Vec::as_slice),
         1.0,
         &six,
         &FitOptions::default(),
@@ -206,8 +206,8 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
     for &t in &soak.temperatures_c {
         let input = driftless::calib::six_position::SixPositionInput::from_manifest_columns(
             &proto.manifest,
-            &out.accel,
-            &out.gyro,
+            out.accel.each_ref().map(Vec::as_slice),
+            out.gyro.each_ref().map(Vec::as_slice),
             1.0,
             t,
         )

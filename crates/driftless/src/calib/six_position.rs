@@ -752,7 +752,7 @@ fn channel_stats(col: &[f64], scale: f64) -> (f64, f64, f64) {
 
 type Stats3 = (Vec3, Vec3, Vec3);
 
-fn triad_stats(cols: &[Vec<f64>; 3], range: std::ops::Range<usize>, scale: f64) -> Stats3 {
+fn triad_stats(cols: &[&[f64]; 3], range: std::ops::Range<usize>, scale: f64) -> Stats3 {
     let s: [(f64, f64, f64); 3] =
         std::array::from_fn(|k| channel_stats(&cols[k][range.clone()], scale));
     (s.map(|v| v.0), s.map(|v| v.1), s.map(|v| v.2))
@@ -781,8 +781,8 @@ impl SixPositionInput {
         };
         SixPositionInput::from_manifest_columns(
             manifest,
-            &out.accel,
-            &out.gyro,
+            out.accel.each_ref().map(Vec::as_slice),
+            out.gyro.each_ref().map(Vec::as_slice),
             scale,
             set_temperature_c,
         )
@@ -794,14 +794,14 @@ impl SixPositionInput {
     /// rates; 1/Δt for increments).
     pub fn from_manifest_columns(
         manifest: &ChamberManifest,
-        accel: &[Vec<f64>; 3],
-        gyro: &[Vec<f64>; 3],
+        accel: [&[f64]; 3],
+        gyro: [&[f64]; 3],
         scale: f64,
         set_temperature_c: f64,
     ) -> Result<SixPositionInput, SixPositionError> {
         let fs = manifest.sample_rate_hz;
         let len = accel[0].len();
-        if accel.iter().chain(gyro).any(|c| c.len() != len) {
+        if accel.iter().chain(&gyro).any(|c| c.len() != len) {
             return Err(SixPositionError::Invalid(
                 "accelerometer and gyro columns differ in length".into(),
             ));
@@ -828,8 +828,8 @@ impl SixPositionInput {
             let n = range.len();
             match seg.kind {
                 SegmentKind::Position { up } => {
-                    let (am, asd, apk) = triad_stats(accel, range.clone(), scale);
-                    let (gm, gsd, gpk) = triad_stats(gyro, range, scale);
+                    let (am, asd, apk) = triad_stats(&accel, range.clone(), scale);
+                    let (gm, gsd, gpk) = triad_stats(&gyro, range, scale);
                     input.positions.push(PositionMean {
                         up,
                         c_bn: up.c_bn_up(),
@@ -843,7 +843,7 @@ impl SixPositionInput {
                     });
                 }
                 SegmentKind::Rate { axis, rate_rad_s } => {
-                    let (gm, gsd, gpk) = triad_stats(gyro, range, scale);
+                    let (gm, gsd, gpk) = triad_stats(&gyro, range, scale);
                     input.rates.push(RateMean {
                         axis,
                         rate_rad_s,

@@ -106,6 +106,20 @@ impl ImuLog {
     pub fn channel(&self, name: &str) -> Option<&Channel> {
         self.channels.iter().find(|c| c.name == name)
     }
+    /// Indices of the channels of quantity `q`, in file order.
+    pub fn indices_of(&self, q: Quantity) -> Vec<usize> {
+        (0..self.channels.len())
+            .filter(|&i| self.channels[i].quantity == q)
+            .collect()
+    }
+    /// The samples of the channels of quantity `q` as a triad (x, y, z in file order),
+    /// when there are exactly three.
+    pub fn triad_of(&self, q: Quantity) -> Option<[&[f64]; 3]> {
+        match self.indices_of(q).as_slice() {
+            &[a, b, c] => Some([a, b, c].map(|i| self.channels[i].values.as_slice())),
+            _ => None,
+        }
+    }
     /// Number of samples per channel.
     pub fn len(&self) -> usize {
         self.channels.first().map(|c| c.values.len()).unwrap_or(0)

@@ -552,17 +552,11 @@ fn pick_channels<'a>(log: &'a ImuLog, which: &RateChannels) -> Result<RateColumn
             .join(", ")
     };
     let by_quantity = |q: Quantity, what: &str| -> Result<[&'a [f64]; 3], String> {
-        let found: Vec<&'a [f64]> = log
-            .channels
-            .iter()
-            .filter(|c| c.quantity == q)
-            .map(|c| c.values.as_slice())
-            .collect();
-        <[&[f64]; 3]>::try_from(found.as_slice()).map_err(|_| {
+        log.triad_of(q).ok_or_else(|| {
             format!(
                 "expected exactly 3 {what} channels ({}), found {}; channels: {}; name them explicitly or give their units",
                 q.si_unit(),
-                found.len(),
+                log.indices_of(q).len(),
                 available()
             )
         })

@@ -116,7 +116,6 @@ pub struct RampCalibration {
 /// sub-LSB value, which only the mean recovers.
 fn robust_mean_and_se(v: &mut [f64]) -> (f64, f64) {
     v.sort_by(f64::total_cmp);
-    let n = v.len();
     let mid = |w: &[f64]| {
         let k = w.len();
         if k % 2 == 1 {
@@ -137,7 +136,6 @@ fn robust_mean_and_se(v: &mut [f64]) -> (f64, f64) {
     let k = kept.len().max(1) as f64;
     let m = kept.iter().sum::<f64>() / k;
     let var = kept.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (k - 1.0).max(1.0);
-    let _ = n;
     (m, (var / k).sqrt())
 }
 

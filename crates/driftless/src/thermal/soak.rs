@@ -199,8 +199,8 @@ fn scale_sigma(est: &TriadEstimate) -> [f64; 3] {
 /// and scale series weighted by its standard errors.
 pub fn soak_calibration(
     manifest: &ChamberManifest,
-    accel: &[Vec<f64>; 3],
-    gyro: &[Vec<f64>; 3],
+    accel: [&[f64]; 3],
+    gyro: [&[f64]; 3],
     scale: f64,
     six: &SixPositionOptions,
     fit_opts: &FitOptions,
