@@ -300,14 +300,10 @@ fn nav_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
         // End to end as KF-GINS is used: its text IMU and GNSS files and YAML in, its
         // three output files out (`driftless nav --kf-gins`).
         {
-            use driftless::io::nav::{ImuIncrements, write_kfgins_gnss, write_kfgins_imu};
+            use driftless::io::nav::{write_kfgins_gnss, write_kfgins_imu};
             let dir = a.dir.join("kfgins");
             std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-            let cols = ImuIncrements {
-                time_s: incs.iter().map(|i| i.time_s).collect(),
-                dtheta_rad: incs.iter().map(|i| i.dtheta_rad).collect(),
-                dvel_m_s: incs.iter().map(|i| i.dvel_m_s).collect(),
-            };
+            let cols = driftless::nav::pipeline::increment_columns(&incs);
             let imu_file = dir.join("imu.txt");
             write_kfgins_imu(
                 std::io::BufWriter::new(std::fs::File::create(&imu_file)?),

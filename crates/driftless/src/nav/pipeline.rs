@@ -503,6 +503,16 @@ fn build_stream(
     })
 }
 
+/// Increments as KF-GINS columns (the inverse of [`imu_from_kfgins`]; for writing them
+/// with [`crate::io::nav::write_kfgins_imu`]).
+pub fn increment_columns(incs: &[ImuIncrement]) -> ImuIncrements {
+    ImuIncrements {
+        time_s: incs.iter().map(|i| i.time_s).collect(),
+        dtheta_rad: incs.iter().map(|i| i.dtheta_rad).collect(),
+        dvel_m_s: incs.iter().map(|i| i.dvel_m_s).collect(),
+    }
+}
+
 /// Stream from KF-GINS increments (already Δθ rad, Δv m/s per interval ending at `time_s`).
 /// The first epoch's `dt_s` is the nominal interval. `source` names the data in messages.
 pub fn imu_from_kfgins(

@@ -690,12 +690,7 @@ impl Simulation {
 
     /// The IMU output as KF-GINS increments.
     pub fn increments(&self) -> crate::io::nav::ImuIncrements {
-        let inc = self.imu.to_increments();
-        crate::io::nav::ImuIncrements {
-            time_s: inc.iter().map(|i| i.time_s).collect(),
-            dtheta_rad: inc.iter().map(|i| i.dtheta_rad).collect(),
-            dvel_m_s: inc.iter().map(|i| i.dvel_m_s).collect(),
-        }
+        crate::nav::pipeline::increment_columns(&self.imu.to_increments())
     }
 }
 

@@ -873,6 +873,18 @@ fn append_std(
     Ok(n)
 }
 
+/// The three output paths in `dir`: `.nav`, IMU error, std.
+fn output_paths(dir: &Path) -> [PathBuf; 3] {
+    [NAV_FILE, IMU_ERR_FILE, STD_FILE].map(|f| dir.join(f))
+}
+
+/// Creates (truncates) one output file with a 1 MiB buffer.
+fn create_output(p: &Path) -> Result<std::io::BufWriter<std::fs::File>, LogError> {
+    std::fs::File::create(p)
+        .map(|f| std::io::BufWriter::with_capacity(1 << 20, f))
+        .map_err(|e| io_error(&p.display().to_string(), e))
+}
+
 /// KF-GINS's three output files, written block by block — e.g. on one thread while a
 /// filter on another produces the blocks ([`crate::nav::filter::run_forward_observed`]).
 pub struct KfGinsOutputWriter {
@@ -887,19 +899,13 @@ impl KfGinsOutputWriter {
     /// Creates (truncates) the three files in `dir` (KF-GINS's `outputpath`, which must
     /// exist, as in KF-GINS).
     pub fn create(dir: impl AsRef<Path>, gps_week: u16) -> Result<Self, LogError> {
-        let dir = dir.as_ref();
-        let paths = [
-            dir.join(NAV_FILE),
-            dir.join(IMU_ERR_FILE),
-            dir.join(STD_FILE),
-        ];
-        let create = |p: &Path| {
-            std::fs::File::create(p)
-                .map(|f| std::io::BufWriter::with_capacity(1 << 20, f))
-                .map_err(|e| io_error(&p.display().to_string(), e))
-        };
+        let paths = output_paths(dir.as_ref());
         Ok(KfGinsOutputWriter {
-            files: [create(&paths[0])?, create(&paths[1])?, create(&paths[2])?],
+            files: [
+                create_output(&paths[0])?,
+                create_output(&paths[1])?,
+                create_output(&paths[2])?,
+            ],
             names: [0, 1, 2].map(|k| paths[k].display().to_string()),
             paths,
             rows: 0,
@@ -946,20 +952,8 @@ pub fn write_kfgins_outputs(
     std: &NavStd,
     gps_week: u16,
 ) -> Result<[PathBuf; 3], LogError> {
-    let dir = dir.as_ref();
-    let paths = [
-        dir.join(NAV_FILE),
-        dir.join(IMU_ERR_FILE),
-        dir.join(STD_FILE),
-    ];
-    let create = |p: &Path| {
-        std::fs::File::create(p)
-            .map(std::io::BufWriter::new)
-            .map_err(|error| LogError::Io {
-                path: p.display().to_string(),
-                error,
-            })
-    };
+    let paths = output_paths(dir.as_ref());
+    let create = create_output;
     let name = |p: &Path| p.display().to_string();
     // The three files are independent and formatting-bound: write them concurrently.
     let ((nav, err), std_res) = rayon::join(
