@@ -65,6 +65,12 @@ pub struct SoakArgs {
     /// Reference temperature, °C.
     #[arg(long, default_value_t = 25.0, allow_hyphen_values = true)]
     pub t_ref: f64,
+    /// Allan noise model of the sensor (`driftless allan --save-model`): its bias
+    /// instability and rate random walk make the bias fits generalised least squares
+    /// with the drift between temperature steps in the covariance, so the bands include
+    /// it (without it they describe only the scatter within each step).
+    #[arg(long, value_name = "FILE.toml")]
+    pub noise_model: Option<PathBuf>,
     /// Outside the soaked range: clamp, extrapolate or error.
     #[arg(long, default_value = "clamp")]
     pub out_of_range: String,
@@ -120,7 +126,17 @@ fn soak(s: SoakArgs) -> Result<()> {
     };
     let six = SixPositionOptions::from_manifest(&manifest);
     let t = std::time::Instant::now();
-    let soak = soak_calibration(&manifest, accel, gyro, 1.0, &six, &fit_opts)?;
+    let drift = match &s.noise_model {
+        Some(p) => {
+            let m = driftless::allan::noise_model::NoiseModel::load(p)?;
+            Some(
+                driftless::thermal::soak::SoakDrift::from_noise_model(&m)
+                    .with_context(|| format!("{}", p.display()))?,
+            )
+        }
+        None => None,
+    };
+    let soak = soak_calibration(&manifest, accel, gyro, 1.0, &six, &fit_opts, drift.as_ref())?;
     // A model id from the coefficients (stable for the same fit; < 2⁶³: TOML integers
     // are signed 64-bit).
     let id = soak

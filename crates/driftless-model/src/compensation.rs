@@ -87,7 +87,7 @@ use core::fmt;
 
 use crate::calib::{ImuCalibration, TriadCalibration};
 use crate::linalg::{Mat3, Vec3};
-use crate::thermal::ThermalPoly;
+use crate::thermal::{MAX_ORDER, ThermalPoly};
 
 /// Temperature-dependent deltas of one triad, about T_ref (zero there).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -288,6 +288,7 @@ pub struct CompensationModel {
     accel: Option<TriadThermal>,
     range_c: [f64; 2],
     policy: OutOfRange,
+    bank: DeltaBank,
 }
 
 /// Effective f32 calibration of one triad at one temperature.
@@ -360,38 +361,105 @@ fn check_delta(p: &ThermalPoly, range_c: [f64; 2], max: f64) -> Result<(), Compe
     Ok(())
 }
 
-/// p(t_c) in the form (c₀ + c₁d) + d²(c₂ + c₃d) + d⁴(c₄ + c₅d), d = t_c − T_ref: the
-/// same polynomial as [`ThermalPoly::eval`] with a shorter dependency chain.
-#[inline(always)]
-fn eval_fast(p: &ThermalPoly, t_c: f64) -> f64 {
-    let c = p.coeffs();
-    let d = t_c - p.t_ref_c();
-    let d2 = d * d;
-    let d4 = d2 * d2;
-    (c[0] + c[1] * d) + d2 * (c[2] + c[3] * d) + d4 * (c[4] + c[5] * d)
+/// Lanes of a [`DeltaBank`]: bias deltas gyro x, y, z, accelerometer x, y, z, then the
+/// scale deltas in the same order.
+const LANES: usize = 12;
+
+/// The 12 delta polynomials of a model in structure-of-arrays form, so that one
+/// temperature evaluates all of them (and the six reciprocal scale factors) in loops the
+/// compiler vectorises. Each lane is p(t_c) in the form (c₀ + c₁d) + d²(c₂ + c₃d) +
+/// d⁴(c₄ + c₅d), d = t_c − T_ref — the same polynomial as [`ThermalPoly::eval`] with a
+/// shorter dependency chain. Lanes of an absent triad are zero and ignored.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct DeltaBank {
+    t_ref_c: [f64; LANES],
+    c: [[f64; LANES]; MAX_ORDER + 1],
+    /// Every lane has c₄ = c₅ = 0 (the usual cubic model): skip the d⁴ term, which is
+    /// exactly +0 then.
+    cubic: bool,
 }
 
-/// Effective calibration of one triad at the (already policy-resolved) temperature.
-#[inline]
+/// The evaluated deltas at one temperature: Δb per lane (gyro x, y, z, accel x, y, z)
+/// and 1/(1 + Δs) per lane, with whether every 1 + Δs of the triad was finite and
+/// non-zero.
+struct Deltas {
+    bias: [f64; 6],
+    inv_scale: [f64; 6],
+    ok: [bool; 2],
+}
+
+impl DeltaBank {
+    fn new(gyro: &Option<TriadThermal>, accel: &Option<TriadThermal>) -> DeltaBank {
+        let mut bank = DeltaBank {
+            t_ref_c: [0.0; LANES],
+            c: [[0.0; LANES]; MAX_ORDER + 1],
+            cubic: true,
+        };
+        for (base, th) in [(0, gyro), (3, accel)] {
+            let Some(th) = th else { continue };
+            let lanes = (0..3).map(|k| (base + k, &th.bias_delta[k]));
+            let lanes = lanes.chain((0..3).map(|k| (6 + base + k, &th.scale_delta[k])));
+            for (lane, p) in lanes {
+                bank.t_ref_c[lane] = p.t_ref_c();
+                for (row, &ck) in bank.c.iter_mut().zip(p.coeffs()) {
+                    row[lane] = ck;
+                }
+            }
+        }
+        bank.cubic = bank.c[4..].iter().flatten().all(|&c| c == 0.0);
+        bank
+    }
+
+    #[inline(always)]
+    fn eval(&self, t_c: f64) -> Deltas {
+        let mut v = [0.0; LANES];
+        let [c0, c1, c2, c3, c4, c5] = &self.c;
+        if self.cubic {
+            for l in 0..LANES {
+                let d = t_c - self.t_ref_c[l];
+                v[l] = (c0[l] + c1[l] * d) + d * d * (c2[l] + c3[l] * d);
+            }
+        } else {
+            for l in 0..LANES {
+                let d = t_c - self.t_ref_c[l];
+                let d2 = d * d;
+                let d4 = d2 * d2;
+                v[l] = (c0[l] + c1[l] * d) + d2 * (c2[l] + c3[l] * d) + d4 * (c4[l] + c5[l] * d);
+            }
+        }
+        let mut out = Deltas {
+            bias: [0.0; 6],
+            inv_scale: [0.0; 6],
+            ok: [true; 2],
+        };
+        out.bias.copy_from_slice(&v[..6]);
+        for l in 0..6 {
+            let den = 1.0 + v[6 + l];
+            out.ok[l / 3] &= den != 0.0 && den.is_finite() && v[l].is_finite();
+            out.inv_scale[l] = 1.0 / den;
+        }
+        out
+    }
+}
+
+/// Effective calibration of one triad from its evaluated bias deltas and reciprocal
+/// scale factors; `t_c` is the reading, for the error.
+#[inline(always)]
 fn triad_at(
     cal: &TriadCalibration,
-    th: &Option<TriadThermal>,
-    t_eval_c: f64,
+    bias: &[f64],
+    inv_scale: &[f64],
+    ok: bool,
     t_c: f64,
 ) -> Result<TriadCalibration, CompensationError> {
-    let Some(th) = th else {
-        return Ok(*cal);
-    };
+    if !ok {
+        return Err(CompensationError::SingularScale { t_c });
+    }
     let mut out = *cal;
     for k in 0..3 {
-        out.bias[k] += eval_fast(&th.bias_delta[k], t_eval_c);
-        let den = 1.0 + eval_fast(&th.scale_delta[k], t_eval_c);
-        if den == 0.0 || !den.is_finite() {
-            return Err(CompensationError::SingularScale { t_c });
-        }
-        let inv = 1.0 / den;
+        out.bias[k] += bias[k];
         for row in out.matrix.0.iter_mut() {
-            row[k] *= inv;
+            row[k] *= inv_scale[k];
         }
     }
     if !out.bias.iter().all(|b| b.is_finite()) {
@@ -444,6 +512,7 @@ impl CompensationModel {
             accel,
             range_c,
             policy,
+            bank: DeltaBank::new(&gyro, &accel),
         })
     }
 
@@ -512,9 +581,17 @@ impl CompensationModel {
     /// M(T) = M·diag(1/(1 + Δs(T))), per triad, after the out-of-range policy.
     pub fn calibration_at(&self, t_c: f64) -> Result<ImuCalibration, CompensationError> {
         let t = self.eval_temperature(t_c)?;
+        let v = self.bank.eval(t);
+        let (b, s) = (&v.bias, &v.inv_scale);
         Ok(ImuCalibration {
-            gyro: triad_at(&self.calibration.gyro, &self.gyro, t, t_c)?,
-            accel: triad_at(&self.calibration.accel, &self.accel, t, t_c)?,
+            gyro: match self.gyro {
+                Some(_) => triad_at(&self.calibration.gyro, &b[..3], &s[..3], v.ok[0], t_c)?,
+                None => self.calibration.gyro,
+            },
+            accel: match self.accel {
+                Some(_) => triad_at(&self.calibration.accel, &b[3..], &s[3..], v.ok[1], t_c)?,
+                None => self.calibration.accel,
+            },
         })
     }
 

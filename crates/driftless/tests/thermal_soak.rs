@@ -4,14 +4,24 @@
 //! range) of the truth, and the truth inside the reported 95 % band at ≥ 90 % of the
 //! temperatures.
 //!
-//! Asserted with the preset's deterministic errors, turn-on biases and white noise
-//! (worst 1.37 % of swing, band coverage 93.3 %). With every noise term of the preset
-//! the bar is **not met yet** (printed by `ADI_ALL_TERMS=1`): its accelerometer rate random
-//! walk (1.3e-4 m/s²/√s, ≈ 2 mg over the 5.2-h protocol) and slow bias instability move
-//! the bias between and within temperature steps by ~0.5–1 % of the swing, and the
-//! output quantization of a constant input adds a ~1e-3 m/s² offset; neither is in the
-//! six-position σ (rescaling the fit's σ by its χ²/dof does not help: 70.4 % — the
-//! drift is correlated across temperatures, not scatter).
+//! * `deterministic_and_white_noise`: the preset's deterministic errors, turn-on biases
+//!   and white noise, temperatures ascending (worst 1.37 % of swing, band coverage 93.3 %).
+//! * `every_noise_term`: every noise term of the preset, including its bias instability
+//!   and rate random walk (K = 160 °/h/√h gyro, 1.3e-4 m/s²/√s accel: ≈ 1.8e-3 rad/s and
+//!   0.018 m/s² over the 5.2-h protocol — 5 % of the gyro-z bias swing). Two measures:
+//!   - the bias series are fitted by generalised least squares with the drift covariance
+//!     from the Allan terms (`SoakDrift`), so the band covers the drift: without it the
+//!     coverage was 67.5 %;
+//!   - the set temperatures are visited in an interleaved order (k·7 mod 20), so the
+//!     drift is not a smooth function of temperature: ascending, the worst curve was
+//!     2.4–8.3 % of its swing over 8 seeds; interleaved, the thermal part of every bias
+//!     curve, Δb(T) = b(T) − b(25 °C), is within 1 % over 12 seeds.
+//!
+//!   What remains (printed, not asserted — the bar is **not met** here): the value at
+//!   25 °C carries the random walk between turn-on and the steps (within 1.5σ of its
+//!   reported σ; worst full-curve error 1.6–4.1 % of swing over 12 seeds), and the
+//!   accelerometer scale factors (swing only 0.3 %) take up to 2.8 % of their swing from
+//!   drift between the ± positions of a step.
 
 use driftless::calib::six_position::SixPositionOptions;
 use driftless::sim::chamber::ChamberConfig;
@@ -19,10 +29,54 @@ use driftless::sim::chamber_manifest::SegmentKind;
 use driftless::sim::presets::Preset;
 use driftless::sim::sensor::{OutputKind, SensorModel};
 use driftless::thermal::FitOptions;
-use driftless::thermal::soak::soak_calibration;
+use driftless::thermal::soak::{ChannelDrift, SoakDrift, soak_calibration};
+
+/// Figures of one run.
+struct Run {
+    /// Worst RMS error over the range / swing, over the 12 series.
+    worst: f64,
+    /// Worst RMS error of the thermal part (value at 25 °C removed) / swing, bias series.
+    worst_bias_shape: f64,
+    /// Fraction of (series, temperature) with the truth inside the 95 % band.
+    coverage: f64,
+    /// RMS static accelerometer error with the model / with the room calibration alone.
+    compensated_fraction: f64,
+}
 
 #[test]
-fn adi_like_chamber_recovers_the_thermal_curves() {
+fn deterministic_and_white_noise() {
+    let r = run(2026, false);
+    assert!(r.worst <= 0.02, "worst {:.4}", r.worst);
+    assert!(r.coverage >= 0.90, "band coverage {}", r.coverage);
+    assert!(r.compensated_fraction <= 0.05, "{}", r.compensated_fraction);
+}
+
+#[test]
+fn every_noise_term() {
+    for seed in 1..=3 {
+        let r = run(seed, true);
+        eprintln!(
+            "seed {seed}: worst curve {:.2} %, worst bias thermal part {:.2} %, coverage {:.1} %",
+            100.0 * r.worst,
+            100.0 * r.worst_bias_shape,
+            100.0 * r.coverage
+        );
+        assert!(
+            r.coverage >= 0.90,
+            "seed {seed}: band coverage {}",
+            r.coverage
+        );
+        assert!(
+            r.worst_bias_shape <= 0.02,
+            "seed {seed}: {}",
+            r.worst_bias_shape
+        );
+        // The static positions' error left by the model is the sensor's own drift
+        // (≈ 0.015 m/s² RMS, 6 % of the room-calibration-only error); not asserted.
+    }
+}
+
+fn run(seed: u64, all_terms: bool) -> Run {
     let t0 = std::time::Instant::now();
     let proto = ChamberConfig {
         soak_s: 600.0,
@@ -32,12 +86,18 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
         rate_revolutions: 2,
         spin_s: 2.0,
         sample_rate_hz: 100.0,
+        temperatures_c: if all_terms {
+            (0..20)
+                .map(|i| -25.0 + 5.0 * ((i * 7) % 20) as f64)
+                .collect()
+        } else {
+            (0..20).map(|i| -25.0 + 5.0 * i as f64).collect()
+        },
         ..ChamberConfig::default()
     }
     .build()
     .expect("protocol");
     let mut cfg = Preset::AdiLike.config();
-    let all_terms = std::env::var_os("ADI_ALL_TERMS").is_some();
     if !all_terms {
         // deterministic errors, turn-on biases and white noise only (module docs)
         for n in cfg.gyro.noise.iter_mut().chain(cfg.accel.noise.iter_mut()) {
@@ -52,7 +112,7 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
     let model = SensorModel::new(cfg.clone()).expect("model");
     let curve = proto.temperature.curve().expect("temperature");
     let out = model
-        .simulate(&proto.ideal(OutputKind::Rates), &curve, 2026)
+        .simulate(&proto.ideal(OutputKind::Rates), &curve, seed)
         .expect("simulate");
     let sim_s = t0.elapsed().as_secs_f64();
     // The same run's slow noise alone (bias instability, rate random walk: every
@@ -71,7 +131,7 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
     let ideal = proto.ideal(OutputKind::Rates);
     let slow = SensorModel::new(slow_cfg)
         .expect("model")
-        .simulate(&ideal, &curve, 2026)
+        .simulate(&ideal, &curve, seed)
         .expect("simulate");
     // Its mean over the static positions of each set temperature, per channel.
     let slow_mean = |channel: usize, t: f64| -> f64 {
@@ -101,6 +161,15 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
         s / n.max(1) as f64
     };
     let six = SixPositionOptions::from_manifest(&proto.manifest);
+    // The drift model from the preset's Allan terms (what `driftless allan` reports).
+    let ch = |n: &driftless::sim::sensor_config::AxisNoise| ChannelDrift {
+        bias_instability: n.bias_instability,
+        rate_random_walk: n.rate_random_walk,
+    };
+    let drift = SoakDrift {
+        accel: cfg.accel.noise.each_ref().map(ch),
+        gyro: cfg.gyro.noise.each_ref().map(ch),
+    };
     let t1 = std::time::Instant::now();
     let soak = soak_calibration(
         &proto.manifest,
@@ -109,6 +178,7 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
         1.0,
         &six,
         &FitOptions::default(),
+        all_terms.then_some(&drift),
     )
     .expect("soak calibration");
     let fit_s = t1.elapsed().as_secs_f64();
@@ -129,6 +199,7 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
     };
     let grid: Vec<f64> = (0..=95).map(|i| -25.0 + i as f64).collect();
     let (mut worst, mut inside, mut total) = (0.0f64, 0usize, 0usize);
+    let mut worst_bias_shape = 0.0f64;
     for s in &soak.series {
         let tr: Vec<f64> = grid
             .iter()
@@ -143,6 +214,18 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
             .sum::<f64>()
             / grid.len() as f64)
             .sqrt();
+        let i25 = grid.iter().position(|&t| t == 25.0).expect("25 °C");
+        let off = s.fit.eval(25.0) - tr[i25];
+        let shape = (grid
+            .iter()
+            .zip(&tr)
+            .map(|(&t, y)| (s.fit.eval(t) - y - off).powi(2))
+            .sum::<f64>()
+            / grid.len() as f64)
+            .sqrt();
+        if s.quantity == "bias" {
+            worst_bias_shape = worst_bias_shape.max(shape / swing);
+        }
         let mut ins = 0;
         let ch = if s.triad == "accel" {
             3 + s.axis
@@ -152,38 +235,32 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
         let mut eff2 = 0.0;
         for &t in &soak.temperatures_c {
             let b = s.fit.band(t, 0.95).expect("band");
-            let mut y = truth(s.triad, s.quantity, s.axis, t);
-            if s.quantity == "bias" {
-                y += slow_mean(ch, t);
-            }
-            eff2 += (b.value - y).powi(2);
+            let y = truth(s.triad, s.quantity, s.axis, t);
+            let slow = if s.quantity == "bias" {
+                slow_mean(ch, t)
+            } else {
+                0.0
+            };
+            eff2 += (b.value - y - slow).powi(2);
             ins += usize::from(y >= b.lo && y <= b.hi);
         }
         eprintln!(
-            "   vs the bias in effect at the set temperatures: RMS {:.3e}",
-            (eff2 / soak.temperatures_c.len() as f64).sqrt()
-        );
-        eprintln!(
-            "{} {} {}: swing {:.4e}, RMS error {:.3e} = {:.2} % of swing, truth in band at {}/{} temperatures",
+            "{} {} {}: swing {:.4e}, RMS error {:.3e} = {:.2} % of swing (thermal part {:.2} %; \
+             vs the bias in effect at the set temperatures {:.3e}), truth in band at {}/{} temperatures",
             s.triad,
             s.quantity,
             ["x", "y", "z"][s.axis],
             swing,
             rms,
             100.0 * rms / swing,
+            100.0 * shape / swing,
+            (eff2 / soak.temperatures_c.len() as f64).sqrt(),
             ins,
             soak.temperatures_c.len()
         );
         worst = worst.max(rms / swing);
         inside += ins;
         total += soak.temperatures_c.len();
-        assert!(
-            all_terms || rms <= 0.02 * swing,
-            "{} {} {}: {rms} vs swing {swing}",
-            s.triad,
-            s.quantity,
-            s.axis
-        );
     }
     let frac = inside as f64 / total as f64;
     eprintln!(
@@ -193,7 +270,6 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
         100.0 * worst,
         100.0 * frac
     );
-    assert!(all_terms || frac >= 0.90, "band coverage {frac}");
 
     // The compensation model built from the soak, applied to every static position of
     // every temperature: the thermal error left, against the room calibration alone.
@@ -230,7 +306,6 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
         "compensation of the static positions over −25…70 °C: accelerometer error RMS {rc:.3e} m/s² with the thermal model vs {rr:.3e} with the room calibration alone ({:.1} %)",
         100.0 * rc / rr
     );
-    assert!(all_terms || rc <= 0.05 * rr, "{rc} vs {rr}");
 
     // The model file round trip: the same compensation, bit for bit.
     use driftless::thermal::model_file::ThermalModelFile;
@@ -252,4 +327,10 @@ fn adi_like_chamber_recovers_the_thermal_curves() {
     let e = ThermalModelFile::load(&path).unwrap_err().to_string();
     assert!(e.contains("out_of_range") && e.contains("wrap"), "{e}");
     let _ = std::fs::remove_file(&path);
+    Run {
+        worst,
+        worst_bias_shape,
+        coverage: frac,
+        compensated_fraction: rc / rr,
+    }
 }

@@ -95,6 +95,9 @@ pub enum ThermalFitError {
     /// The weighted design matrix is numerically rank-deficient.
     #[error("the design matrix is numerically rank-deficient (column {0})")]
     RankDeficient(usize),
+    /// The covariance given to [`fit_correlated`] is not symmetric positive definite.
+    #[error("the point covariance is not symmetric positive definite")]
+    CovarianceNotPositiveDefinite,
     /// The confidence level is not in (0, 1).
     #[error("confidence level {0} is not in (0, 1)")]
     BadLevel(f64),
@@ -352,6 +355,28 @@ fn solve_scaled(
     idx: &[usize],
     m: usize,
 ) -> Result<Core, ThermalFitError> {
+    solve_scaled_whitened(t_c, y, sigma, None, idx, m)
+}
+
+/// Forward substitution x ← L⁻¹x for lower-triangular L (n×n row-major).
+fn forward_substitute(l: &[f64], n: usize, x: &mut [f64]) {
+    for i in 0..n {
+        let s: f64 = (0..i).map(|j| l[i * n + j] * x[j]).sum();
+        x[i] = (x[i] - s) / l[i * n + i];
+    }
+}
+
+/// [`solve_scaled`], or with `chol` = L (lower-triangular Cholesky factor of the points'
+/// full covariance C = LLᵀ, over all points in input order, `idx` = 0..n): generalised
+/// least squares by whitening, A ← L⁻¹A, y ← L⁻¹y (Golub & Van Loan §6.1.2).
+fn solve_scaled_whitened(
+    t_c: &[f64],
+    y: &[f64],
+    sigma: Option<&[f64]>,
+    chol: Option<&[f64]>,
+    idx: &[usize],
+    m: usize,
+) -> Result<Core, ThermalFitError> {
     let n = idx.len();
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for &i in idx {
@@ -372,6 +397,19 @@ fn solve_scaled(
             p *= u;
         }
         b[r] = w * y[i];
+    }
+    if let Some(l) = chol {
+        let mut col = vec![0.0; n];
+        for j in 0..m {
+            for r in 0..n {
+                col[r] = a[r * m + j];
+            }
+            forward_substitute(l, n, &mut col);
+            for r in 0..n {
+                a[r * m + j] = col[r];
+            }
+        }
+        forward_substitute(l, n, &mut b);
     }
     // Householder triangularisation, applying each reflector to b as well.
     let mut diag_max: f64 = 0.0;
@@ -421,12 +459,17 @@ fn solve_scaled(
         }
     }
     // Residuals recomputed directly (more accurate than ‖(Qᵀb)[m..]‖ when tiny).
-    let mut rss_w = 0.0;
-    for &i in idx {
-        let w = sigma.map_or(1.0, |s| 1.0 / s[i]);
-        let r = y[i] - horner_scaled(&x, t_centre, half_range, t_c[i]);
-        rss_w += (w * r).powi(2);
+    let mut res: Vec<f64> = idx
+        .iter()
+        .map(|&i| {
+            let w = sigma.map_or(1.0, |s| 1.0 / s[i]);
+            w * (y[i] - horner_scaled(&x, t_centre, half_range, t_c[i]))
+        })
+        .collect();
+    if let Some(l) = chol {
+        forward_substitute(l, n, &mut res);
     }
+    let rss_w = res.iter().map(|r| r * r).sum();
     Ok(Core {
         t_centre,
         half_range,
@@ -468,6 +511,64 @@ pub fn fit(
     sigma: Option<&[f64]>,
     opts: &FitOptions,
 ) -> Result<ThermalFit, ThermalFitError> {
+    fit_impl(t_c, y, sigma, None, opts)
+}
+
+/// Generalised least squares: [`fit`] with the points' errors correlated, full
+/// covariance `covariance` (n×n row-major, symmetric positive definite; e.g. a bias
+/// random walk shared by measurements made one after another). Solved by whitening with
+/// the Cholesky factor C = LLᵀ; Cov(c) = (AᵀC⁻¹A)⁻¹ (given noise scale, or × χ²/dof with
+/// `rescale_given_sigma`). The fit's χ² is the Mahalanobis norm rᵀC⁻¹r.
+pub fn fit_correlated(
+    t_c: &[f64],
+    y: &[f64],
+    covariance: &[f64],
+    opts: &FitOptions,
+) -> Result<ThermalFit, ThermalFitError> {
+    let n = t_c.len();
+    if covariance.len() != n * n {
+        return Err(ThermalFitError::LengthMismatch {
+            what: "covariance (n×n)",
+            expected: n * n,
+            got: covariance.len(),
+        });
+    }
+    let sigma: Vec<f64> = (0..n).map(|i| covariance[i * n + i].sqrt()).collect();
+    validate(t_c, y, Some(&sigma), opts.order, opts.t_ref_c)?;
+    let l = cholesky(covariance, n).ok_or(ThermalFitError::CovarianceNotPositiveDefinite)?;
+    fit_impl(t_c, y, Some(&sigma), Some(&l), opts)
+}
+
+/// Lower-triangular L with C = LLᵀ, or `None` when C is not symmetric positive definite.
+fn cholesky(c: &[f64], n: usize) -> Option<Vec<f64>> {
+    let mut l = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..=i {
+            if (c[i * n + j] - c[j * n + i]).abs() > 1e-12 * (c[i * n + i] * c[j * n + j]).sqrt() {
+                return None;
+            }
+            let s: f64 = (0..j).map(|k| l[i * n + k] * l[j * n + k]).sum();
+            if i == j {
+                let d = c[i * n + i] - s;
+                if !(d > 0.0 && d.is_finite()) {
+                    return None;
+                }
+                l[i * n + i] = d.sqrt();
+            } else {
+                l[i * n + j] = (c[i * n + j] - s) / l[j * n + j];
+            }
+        }
+    }
+    Some(l)
+}
+
+fn fit_impl(
+    t_c: &[f64],
+    y: &[f64],
+    sigma: Option<&[f64]>,
+    chol: Option<&[f64]>,
+    opts: &FitOptions,
+) -> Result<ThermalFit, ThermalFitError> {
     let order = opts.order;
     let n_distinct = validate(t_c, y, sigma, order, opts.t_ref_c)?;
     let n = t_c.len();
@@ -481,7 +582,9 @@ pub fn fit(
         return Err(ThermalFitError::NoResidualDof { points: n, order });
     }
     let idx: Vec<usize> = (0..n).collect();
-    let core = solve_scaled(t_c, y, sigma, &idx, m)?;
+    // With a full covariance the whitening carries the weights.
+    let row_sigma = if chol.is_some() { None } else { sigma };
+    let core = solve_scaled_whitened(t_c, y, row_sigma, chol, &idx, m)?;
     let s2 = match noise_scale {
         NoiseScale::Given => 1.0,
         NoiseScale::Estimated => core.rss_w / dof as f64,
@@ -775,5 +878,67 @@ mod tests {
         assert!((f.covariance[3] - 1.0 / 200.0).abs() < 1e-16);
         assert!((f.covariance[0] - 1.0 / 3.0).abs() < 1e-15);
         assert_eq!(f.dof, 1);
+    }
+
+    #[test]
+    fn gls_diagonal_equals_weighted_and_common_offset_goes_into_c0() {
+        let t = [-20.0, -5.0, 10.0, 25.0, 40.0, 55.0, 70.0];
+        let y: Vec<f64> = t
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| 0.3 + 1e-3 * (t - 25.0) + 0.01 * (i as f64 * 1.7).sin())
+            .collect();
+        let s: Vec<f64> = (0..t.len()).map(|i| 0.01 + 0.002 * i as f64).collect();
+        let n = t.len();
+        let o = FitOptions {
+            order: 2,
+            ..FitOptions::default()
+        };
+        let w = fit(&t, &y, Some(&s), &o).unwrap();
+        let mut c = vec![0.0; n * n];
+        for i in 0..n {
+            c[i * n + i] = s[i] * s[i];
+        }
+        let g = fit_correlated(&t, &y, &c, &o).unwrap();
+        for k in 0..3 {
+            assert!((w.coeffs[k] - g.coeffs[k]).abs() <= 1e-14 * w.coeffs[k].abs().max(1e-3));
+            assert!((w.std_errors[k] - g.std_errors[k]).abs() <= 1e-12 * w.std_errors[k]);
+        }
+        assert!((w.chi2.unwrap() - g.chi2.unwrap()).abs() <= 1e-12 * w.chi2.unwrap());
+        // Equal σ plus a common offset of variance k² (C = σ²I + k²·11ᵀ): a constant
+        // error is absorbed by c₀ alone, so the estimates equal the unweighted ones,
+        // Var(c₁), Var(c₂) are unchanged and Var at any T grows by exactly k².
+        let (sig, k) = (0.01, 0.05);
+        let mut c = vec![k * k; n * n];
+        for i in 0..n {
+            c[i * n + i] += sig * sig;
+        }
+        let e = fit(&t, &y, Some(&[sig; 7]), &o).unwrap();
+        let g = fit_correlated(&t, &y, &c, &o).unwrap();
+        for j in 0..3 {
+            assert!((e.coeffs[j] - g.coeffs[j]).abs() <= 1e-12 * e.coeffs[j].abs().max(1e-3));
+        }
+        for j in 1..3 {
+            assert!((e.std_errors[j] - g.std_errors[j]).abs() <= 1e-9 * e.std_errors[j]);
+        }
+        for tt in [-20.0, 0.0, 33.0, 70.0] {
+            let (ve, vg) = (e.std_error_at(tt).powi(2), g.std_error_at(tt).powi(2));
+            assert!(
+                (vg - ve - k * k).abs() <= 1e-9 * vg,
+                "{tt}: {vg} vs {ve} + {}",
+                k * k
+            );
+        }
+        // Not positive definite → an error, not a NaN fit.
+        let mut bad = vec![0.0; n * n];
+        for i in 0..n {
+            bad[i * n + i] = 1.0;
+        }
+        bad[1] = 2.0;
+        bad[n] = 2.0;
+        assert_eq!(
+            fit_correlated(&t, &y, &bad, &o).unwrap_err(),
+            ThermalFitError::CovarianceNotPositiveDefinite
+        );
     }
 }

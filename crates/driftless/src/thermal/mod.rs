@@ -23,5 +23,5 @@ pub mod stats;
 
 pub use fit::{
     BIC_PARSIMONY, BandPoint, CrossValidation, FitOptions, NoiseScale, OrderAdvice, OrderRow,
-    ThermalFit, ThermalFitError, advise_order, cross_validate, fit,
+    ThermalFit, ThermalFitError, advise_order, cross_validate, fit, fit_correlated,
 };

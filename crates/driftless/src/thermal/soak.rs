@@ -14,12 +14,34 @@
 //!
 //! The temperature of each point is the set temperature (the protocol soaks until the
 //! sensor has settled; the manifest's soak is sized for that).
+//!
+//! # Slow bias noise (drift) between temperature steps
+//!
+//! The six-position σ describes the scatter *within* one temperature step. The bias also
+//! wanders *between* steps — bias instability (flicker) and rate random walk — and a soak
+//! visits the temperatures one after another over hours, so that wander is correlated
+//! with temperature and no fit can tell it from b(T). Given the channel's Allan noise
+//! terms ([`SoakDrift`], e.g. from `driftless allan` on a static log), the bias series are
+//! fitted by generalised least squares ([`super::fit::fit_correlated`]) with the
+//! covariance of the step means t_i (mid-time of the step's static positions, from the
+//! protocol start):
+//!
+//! ```text
+//! C_ij = σ_i² δ_ij + K²·min(t_i, t_j) + Σ_k σ_k² e^{−|t_i − t_j|/T_k}
+//! ```
+//!
+//! — the rate random walk K as Brownian motion from the start (the truth is the bias
+//! at the start plus b(T)); the flicker of bias instability B as the sum of first-order
+//! Gauss-Markov processes with T_k three per decade from the step's averaging time to
+//! ten times the protocol, σ_k² = B²·ln(r)/π (r = 10^⅓; the same synthesis the simulator
+//! documents in [`crate::sim::noise`], after Kasdin 1995). The band then states how well
+//! the *thermal* curve is known, drift included; the fit itself cannot remove the drift.
 
-use super::fit::{FitOptions, ThermalFit, ThermalFitError, fit};
+use super::fit::{FitOptions, ThermalFit, ThermalFitError, fit, fit_correlated};
 use crate::calib::six_position::{
     SixPositionError, SixPositionInput, SixPositionOptions, TriadEstimate, calibrate,
 };
-use crate::sim::chamber_manifest::ChamberManifest;
+use crate::sim::chamber_manifest::{ChamberManifest, SegmentKind};
 
 /// Why a soak calibration failed.
 #[derive(Debug, thiserror::Error)]
@@ -68,6 +90,83 @@ pub struct SeriesFit {
     pub sigma: Vec<f64>,
     /// The fit.
     pub fit: ThermalFit,
+}
+
+/// Slow bias noise of one channel, in the unit of the (scaled) samples: Allan terms.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ChannelDrift {
+    /// Bias instability B (flicker floor of the Allan deviation ≈ 0.664·B), unit.
+    pub bias_instability: f64,
+    /// Rate random walk K, unit/√s.
+    pub rate_random_walk: f64,
+}
+
+/// Slow bias noise of every channel (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SoakDrift {
+    /// Accelerometer x, y, z.
+    pub accel: [ChannelDrift; 3],
+    /// Gyro x, y, z.
+    pub gyro: [ChannelDrift; 3],
+}
+
+impl SoakDrift {
+    /// The bias-instability and rate-random-walk terms of a noise-model file
+    /// (`driftless allan --save-model`): its angular-rate channels are gyro x, y, z and
+    /// its specific-force channels accel x, y, z, in file order (SI units, so the soak's
+    /// samples must be in SI too). A triad without exactly three channels is an error.
+    pub fn from_noise_model(
+        model: &crate::allan::noise_model::NoiseModel,
+    ) -> Result<SoakDrift, SoakError> {
+        use crate::io::Quantity;
+        let triad = |q: Quantity, what: &str| -> Result<[ChannelDrift; 3], SoakError> {
+            let ch: Vec<ChannelDrift> = model
+                .channels
+                .iter()
+                .filter(|c| c.quantity == q)
+                .map(|c| ChannelDrift {
+                    bias_instability: c.fit.bias_instability.map_or(0.0, |t| t.value),
+                    rate_random_walk: c.fit.rate_random_walk.map_or(0.0, |t| t.value),
+                })
+                .collect();
+            <[ChannelDrift; 3]>::try_from(ch).map_err(|v| {
+                SoakError::Model(format!(
+                    "noise model has {} {what} channel(s); the drift model needs 3",
+                    v.len()
+                ))
+            })
+        };
+        Ok(SoakDrift {
+            accel: triad(Quantity::SpecificForce, "specific-force")?,
+            gyro: triad(Quantity::AngularRate, "angular-rate")?,
+        })
+    }
+}
+
+/// C_ij of the drift between step means at `times_s` (module docs), `average_s` the
+/// averaging time of one step, `span_s` the protocol length.
+fn drift_covariance(times_s: &[f64], d: &ChannelDrift, average_s: f64, span_s: f64) -> Vec<f64> {
+    let n = times_s.len();
+    let mut c = vec![0.0; n * n];
+    let k2 = d.rate_random_walk.powi(2);
+    let r: f64 = 10f64.powf(1.0 / 3.0);
+    let var_k = d.bias_instability.powi(2) * r.ln() / std::f64::consts::PI;
+    let mut taus = Vec::new();
+    if var_k > 0.0 {
+        let mut t = average_s.max(1e-3);
+        while t <= 10.0 * span_s.max(average_s) {
+            taus.push(t);
+            t *= r;
+        }
+    }
+    for i in 0..n {
+        for j in 0..n {
+            let dt = (times_s[i] - times_s[j]).abs();
+            let flicker: f64 = taus.iter().map(|tk| var_k * (-dt / tk).exp()).sum();
+            c[i * n + j] = k2 * times_s[i].min(times_s[j]) + flicker;
+        }
+    }
+    c
 }
 
 /// Result of [`soak_calibration`].
@@ -196,7 +295,8 @@ fn scale_sigma(est: &TriadEstimate) -> [f64; 3] {
 
 /// Six-position calibration at every set temperature of `manifest` (sample columns as
 /// for [`SixPositionInput::from_manifest_columns`]), then a polynomial fit of every bias
-/// and scale series weighted by its standard errors.
+/// and scale series weighted by its standard errors — with `drift`, the bias series by
+/// generalised least squares with the drift covariance (module docs).
 pub fn soak_calibration(
     manifest: &ChamberManifest,
     accel: [&[f64]; 3],
@@ -204,6 +304,7 @@ pub fn soak_calibration(
     scale: f64,
     six: &SixPositionOptions,
     fit_opts: &FitOptions,
+    drift: Option<&SoakDrift>,
 ) -> Result<SoakCalibration, SoakError> {
     let mut temps: Vec<f64> = manifest
         .segments
@@ -227,6 +328,25 @@ pub fn soak_calibration(
             calibrate(&input, six).map_err(|source| SoakError::Calibration { t_c: t, source })?;
         ests.push((cal.accel, cal.gyro));
     }
+    // Per temperature: mid-time and total duration of its static positions.
+    let (mut times, mut average_s) = (Vec::with_capacity(temps.len()), f64::INFINITY);
+    for &t in &temps {
+        let (mut w, mut tw) = (0.0, 0.0);
+        for g in manifest
+            .segments
+            .iter()
+            .filter(|g| g.set_temperature_c == t)
+        {
+            if matches!(g.kind, SegmentKind::Position { .. }) {
+                let d = g.end_s - g.start_s;
+                w += d;
+                tw += d * 0.5 * (g.start_s + g.end_s);
+            }
+        }
+        times.push(if w > 0.0 { tw / w } else { 0.0 });
+        average_s = average_s.min(w);
+    }
+    let span_s = manifest.duration_s;
     let mut series = Vec::with_capacity(12);
     for (triad, pick) in [("accel", 0usize), ("gyro", 1usize)] {
         let get =
@@ -245,10 +365,29 @@ pub fn soak_calibration(
                     }
                 }
                 let what = format!("{triad} {quantity} {}", ["x", "y", "z"][axis]);
+                let channel_drift = drift
+                    .map(|d| {
+                        if pick == 0 {
+                            d.accel[axis]
+                        } else {
+                            d.gyro[axis]
+                        }
+                    })
+                    .filter(|d| quantity == "bias" && *d != ChannelDrift::default());
                 // A zero σ (noise-free data) cannot weight a fit: use unit weights then.
                 let weights = sigma.iter().all(|s| *s > 0.0).then_some(sigma.as_slice());
-                let f = fit(&temps, &values, weights, fit_opts)
-                    .map_err(|source| SoakError::Fit { what, source })?;
+                let f = match (channel_drift, weights) {
+                    (Some(d), Some(w)) => {
+                        let n = temps.len();
+                        let mut c = drift_covariance(&times, &d, average_s, span_s);
+                        for i in 0..n {
+                            c[i * n + i] += w[i] * w[i];
+                        }
+                        fit_correlated(&temps, &values, &c, fit_opts)
+                    }
+                    _ => fit(&temps, &values, weights, fit_opts),
+                }
+                .map_err(|source| SoakError::Fit { what, source })?;
                 series.push(SeriesFit {
                     triad,
                     quantity,
