@@ -2,6 +2,10 @@
 //! six-position + rate-table calibration at every set temperature of a chamber
 //! recording, polynomial fits of each bias and scale series, the real-time compensation
 //! model file (`--out`) and the bias/scale-versus-temperature figure (`--plot`).
+//! `driftless thermal ramp LOG [--out MODEL.toml]`: the ramp method, optionally as a
+//! bias-only model file. `driftless thermal export MODEL.toml --px4 F.params
+//! --ardupilot F.param`: the model's bias part as autopilot parameters
+//! (`docs/autopilot-thermal.md`), re-read and checked against the model.
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
@@ -28,6 +32,36 @@ pub enum ThermalMethod {
     Soak(SoakArgs),
     /// Bias versus temperature from one warm-up or cool-down of a static sensor.
     Ramp(RampArgs),
+    /// A model's bias part as PX4 TC_* and/or ArduPilot INS_TCAL* parameter files.
+    Export(ExportArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct ExportArgs {
+    /// Thermal compensation model file (TOML), from `thermal soak|ramp --out`.
+    pub model: PathBuf,
+    /// Write PX4 parameters here (QGroundControl .params).
+    #[arg(long, value_name = "FILE.params")]
+    pub px4: Option<PathBuf>,
+    /// Write ArduPilot parameters here (Mission Planner .param).
+    #[arg(long, value_name = "FILE.param")]
+    pub ardupilot: Option<PathBuf>,
+    /// Sensor instance: PX4 TC_A<N>/TC_G<N> (0-3), ArduPilot INS_TCAL<N+1> (0-2).
+    #[arg(long, default_value_t = 0)]
+    pub instance: usize,
+    /// Only the temperature dependence: no room offsets (PX4 X0 = 0 and no CAL_*OFF;
+    /// ArduPilot no INS_*OFFS / CALTEMP), the vehicle's own calibration stays.
+    #[arg(long)]
+    pub no_offsets: bool,
+    /// PX4 TC_A<N>_ID: the accelerometer's device id (CAL_ACC<N>_ID).
+    #[arg(long, default_value_t = 0)]
+    pub px4_accel_id: i32,
+    /// PX4 TC_G<N>_ID: the gyro's device id (CAL_GYRO<N>_ID).
+    #[arg(long, default_value_t = 0)]
+    pub px4_gyro_id: i32,
+    /// Machine-readable output.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Args, Debug)]
@@ -44,6 +78,10 @@ pub struct RampArgs {
     /// Temperature bin width, °C.
     #[arg(long, default_value_t = 1.0)]
     pub bin: f64,
+    /// Write a bias-only compensation model file here (TOML): matrix I, no scale terms,
+    /// gyro bias = fit at T_ref, accelerometer bias 0 (not separable from gravity).
+    #[arg(long, value_name = "FILE.toml")]
+    pub out: Option<PathBuf>,
     /// Machine-readable output.
     #[arg(long)]
     pub json: bool,
@@ -91,6 +129,7 @@ pub fn run(a: ThermalArgs) -> Result<()> {
     match a.method {
         ThermalMethod::Soak(s) => soak(s),
         ThermalMethod::Ramp(r) => ramp(r),
+        ThermalMethod::Export(e) => export(e),
     }
 }
 
@@ -267,6 +306,39 @@ fn ramp(r: RampArgs) -> Result<()> {
     let res = ramp_calibration(time, &temp.values, &chans, &opts)
         .with_context(|| format!("{}", r.log.display()))?;
     let heating = res.points.iter().filter(|p| p.heating).count();
+    if let Some(p) = &r.out {
+        // x, y, z channel indices (into `chans`) of each triad, when it has exactly three.
+        let triad = |q: Quantity| -> Option<[usize; 3]> {
+            let idx: Vec<usize> = log
+                .channels
+                .iter()
+                .filter(|c| matches!(c.quantity, Quantity::AngularRate | Quantity::SpecificForce))
+                .enumerate()
+                .filter(|(_, c)| c.quantity == q)
+                .map(|(i, _)| i)
+                .collect();
+            <[usize; 3]>::try_from(idx).ok()
+        };
+        let (acc, gyr) = (triad(Quantity::SpecificForce), triad(Quantity::AngularRate));
+        if acc.is_none() && gyr.is_none() {
+            anyhow::bail!(
+                "{}: --out needs three gyro or three accelerometer columns",
+                r.log.display()
+            );
+        }
+        let id = res
+            .fits
+            .iter()
+            .flat_map(|f| f.coeffs.iter())
+            .fold(0xcbf2_9ce4_8422_2325u64, |h, c| {
+                (h ^ c.to_bits()).wrapping_mul(0x0100_0000_01b3)
+            })
+            >> 1;
+        let file = res.bias_model_file(acc, gyr, id)?;
+        // Refuse to write what `compensate` and `export` would not read.
+        file.model(&p.display().to_string())?;
+        file.save(p)?;
+    }
     if r.json {
         let fits: Vec<serde_json::Value> = res
             .names
@@ -289,6 +361,7 @@ fn ramp(r: RampArgs) -> Result<()> {
                 "t_ref_c": r.t_ref,
                 "order": r.order,
                 "fits": fits,
+                "model_file": r.out.as_ref().map(|p| p.display().to_string()),
             }))?
         );
         return Ok(());
@@ -321,5 +394,107 @@ fn ramp(r: RampArgs) -> Result<()> {
         tab.row(row);
     }
     print!("{}", tab.render());
+    if let Some(p) = &r.out {
+        println!("wrote {} (bias-only model)", p.display());
+    }
+    Ok(())
+}
+
+fn export(e: ExportArgs) -> Result<()> {
+    use driftless::thermal::autopilot::{
+        BiasModel, ExportOptions, check_temperatures, compare_ardupilot, compare_px4,
+        export_ardupilot, export_px4, parse_ardupilot, parse_px4,
+    };
+    if e.px4.is_none() && e.ardupilot.is_none() {
+        anyhow::bail!("nothing to write: give --px4 FILE.params and/or --ardupilot FILE.param");
+    }
+    let (file, model) = ThermalModelFile::load(&e.model)?;
+    let name = e.model.display().to_string();
+    let bm = BiasModel::from_model_file(&file, &name)?;
+    let opts = ExportOptions {
+        instance: e.instance,
+        include_offsets: !e.no_offsets,
+        px4_accel_id: e.px4_accel_id,
+        px4_gyro_id: e.px4_gyro_id,
+    };
+    // Every written file is read back and its autopilot's formula compared with the model
+    // at 10 temperatures over the range.
+    let temps = check_temperatures(file.range_c, 10);
+    let mut checks = Vec::new();
+    if let Some(p) = &e.px4 {
+        let text = export_px4(&bm, &opts)?;
+        std::fs::write(p, &text).with_context(|| format!("writing {}", p.display()))?;
+        let back = std::fs::read_to_string(p)?;
+        let parsed = parse_px4(&back, &p.display().to_string(), e.instance)?;
+        let err = compare_px4(&file, &model, &parsed, &temps, e.no_offsets)?;
+        checks.push(("px4", p, err));
+    }
+    if let Some(p) = &e.ardupilot {
+        let text = export_ardupilot(&bm, &opts)?;
+        std::fs::write(p, &text).with_context(|| format!("writing {}", p.display()))?;
+        let back = std::fs::read_to_string(p)?;
+        let mut parsed = parse_ardupilot(&back, &p.display().to_string(), e.instance)?;
+        if e.no_offsets {
+            // No CALTEMP in the file: check relative to T_ref.
+            parsed.acc_caltemp = file.t_ref_c as f32;
+            parsed.gyr_caltemp = file.t_ref_c as f32;
+        }
+        let err = compare_ardupilot(&file, &model, &parsed, &temps, e.no_offsets)?;
+        checks.push(("ardupilot", p, err));
+    }
+    let worst = checks
+        .iter()
+        .map(|(_, _, c)| c.accel_f32.max(c.gyro_f32))
+        .fold(0.0f64, f64::max);
+    let ds = |t: &driftless::thermal::autopilot::TriadBias| {
+        t.scale_delta_max.iter().fold(0.0f64, |a, b| a.max(*b))
+    };
+    if e.json {
+        let files: Vec<serde_json::Value> = checks
+            .iter()
+            .map(|(ap, p, c)| {
+                serde_json::json!({
+                    "autopilot": ap, "file": p.display().to_string(),
+                    "max_error_accel_m_s2": c.accel, "max_error_gyro_rad_s": c.gyro,
+                    "max_error_accel_f32_m_s2": c.accel_f32, "max_error_gyro_f32_rad_s": c.gyro_f32,
+                })
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "model_id": file.model_id,
+                "instance": e.instance,
+                "offsets": !e.no_offsets,
+                "check_temperatures_c": temps,
+                "files": files,
+                "dropped_scale_delta_max": {"accel": ds(&bm.accel), "gyro": ds(&bm.gyro)},
+            }))?
+        );
+    } else {
+        for (ap, p, c) in &checks {
+            println!(
+                "wrote {} ({ap}); read back, max |model − {ap}| over 10 temperatures in \
+                 [{}, {}] °C: accel {} m/s², gyro {} rad/s (float32 arithmetic)",
+                p.display(),
+                file.range_c[0],
+                file.range_c[1],
+                crate::output::sci(c.accel_f32),
+                crate::output::sci(c.gyro_f32)
+            );
+        }
+        println!(
+            "bias only: thermal scale-factor change dropped (max |Δs| accel {}, gyro {}); \
+             misalignment and room scale left to the autopilot's own calibration",
+            crate::output::sci(ds(&bm.accel)),
+            crate::output::sci(ds(&bm.gyro))
+        );
+    }
+    if worst > 1e-6 {
+        anyhow::bail!(
+            "the written parameters differ from the model by {worst:.3e} (> 1e-6) after \
+             float32 rounding: the model's values are too large for float32 parameters"
+        );
+    }
     Ok(())
 }

@@ -188,7 +188,9 @@ fn ramp_on_a_simulated_warm_up() {
     let v = run_json(
         bin()
             .args(["thermal", "ramp", "--json"])
-            .arg(dir.join("sim/imu.csv")),
+            .arg(dir.join("sim/imu.csv"))
+            .arg("--out")
+            .arg(dir.join("ramp-model.toml")),
     );
     let fits = v["fits"].as_array().unwrap();
     assert_eq!(fits.len(), 6);
@@ -217,6 +219,114 @@ fn ramp_on_a_simulated_warm_up() {
     assert!(
         (fitted - want).abs() <= 0.2 * want.abs(),
         "{fitted} vs {want}"
+    );
+    // ramp → bias-only model → autopilot parameters, and `compensate` takes the model.
+    let model = std::fs::read_to_string(dir.join("ramp-model.toml")).unwrap();
+    assert!(model.contains("bias_delta") && model.contains("raw_unit = \"rad/s\""));
+    let e = run_json(
+        bin()
+            .args(["thermal", "export", "--json", "--no-offsets"])
+            .arg(dir.join("ramp-model.toml"))
+            .arg("--px4")
+            .arg(dir.join("tc.params"))
+            .arg("--ardupilot")
+            .arg(dir.join("tc.param")),
+    );
+    for f in e["files"].as_array().unwrap() {
+        assert!(
+            f["max_error_accel_f32_m_s2"].as_f64().unwrap() <= 1e-6,
+            "{f}"
+        );
+        assert!(
+            f["max_error_gyro_f32_rad_s"].as_f64().unwrap() <= 1e-6,
+            "{f}"
+        );
+    }
+    let px4 = std::fs::read_to_string(dir.join("tc.params")).unwrap();
+    assert!(px4.contains("\tTC_G0_X1_0\t") && px4.contains("1\t1\tTC_A0_X0_0\t0\t9\n"));
+    let out = bin()
+        .args(["compensate", "--model"])
+        .arg(dir.join("ramp-model.toml"))
+        .arg("--out")
+        .arg(dir.join("comp.csv"))
+        .arg(dir.join("sim/imu.csv"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `driftless thermal export` on the worked example of docs/autopilot-thermal.md: both
+/// files written and verified; refusals named (nothing to write, order 4, instance).
+#[test]
+fn export_autopilot_parameters() {
+    let dir = std::env::temp_dir().join(format!("driftless-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = "format_version = 1\nmodel_id = 42\nt_ref_c = 25.0\nrange_c = [-10.0, 60.0]\n\
+                 out_of_range = \"clamp\"\n[accel]\nraw_unit = \"m/s^2\"\nbias = [0.2, 0.0, 0.0]\n\
+                 matrix = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\n\
+                 bias_delta = [[0.0, 0.004, -2e-5, 1e-7], [0.0], [0.0]]\n\
+                 scale_delta = [[0.0, 5e-5], [0.0], [0.0]]\n[gyro]\nraw_unit = \"rad/s\"\n\
+                 bias = [0.002, 0.0, 0.0]\nmatrix = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]\n\
+                 bias_delta = [[0.0, 3e-5, 4e-7], [0.0], [0.0]]\nscale_delta = [[0.0], [0.0], [0.0]]\n";
+    std::fs::write(dir.join("m.toml"), model).unwrap();
+    let v = run_json(
+        bin()
+            .args(["thermal", "export", "--json", "--instance", "1"])
+            .arg(dir.join("m.toml"))
+            .args(["--px4-accel-id", "1310988", "--px4"])
+            .arg(dir.join("tc.params"))
+            .arg("--ardupilot")
+            .arg(dir.join("tc.param")),
+    );
+    let files = v["files"].as_array().unwrap();
+    assert_eq!(files.len(), 2);
+    for f in files {
+        let (a, g) = (
+            f["max_error_accel_f32_m_s2"].as_f64().unwrap(),
+            f["max_error_gyro_f32_rad_s"].as_f64().unwrap(),
+        );
+        eprintln!(
+            "export {}: accel {a:.2e} m/s², gyro {g:.2e} rad/s",
+            f["autopilot"]
+        );
+        assert!(a <= 1e-7 && g <= 1e-8, "{f}");
+    }
+    assert!((v["dropped_scale_delta_max"]["accel"].as_f64().unwrap() - 1.75e-3).abs() < 1e-12);
+    let px4 = std::fs::read_to_string(dir.join("tc.params")).unwrap();
+    assert!(px4.contains("1\t1\tTC_A1_X1_0\t0.004\t9\n") && px4.contains("TC_A1_ID\t1310988\t6"));
+    assert!(px4.contains("TC_A1_ID / TC_G1_ID = 0 match no sensor"));
+    let ap = std::fs::read_to_string(dir.join("tc.param")).unwrap();
+    assert!(ap.contains("INS_TCAL2_ACC1_X,3630\n") && ap.contains("INS_ACC2OFFS_X,0.2\n"));
+    assert!(ap.contains("Scale-factor and misalignment terms have no place"));
+
+    let fail = |args: &[&str], model: &std::path::Path| -> String {
+        let out = bin()
+            .args(["thermal", "export"])
+            .arg(model)
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let m = dir.join("m.toml");
+    let p = dir.join("x.params").display().to_string();
+    assert!(fail(&[], &m).contains("nothing to write"));
+    assert!(fail(&["--instance", "4", "--px4", &p], &m).contains("PX4 has instances 0..=3"));
+    std::fs::write(
+        dir.join("m4.toml"),
+        model.replace("[0.0, 3e-5, 4e-7]", "[0.0, 3e-5, 4e-7, 0.0, 1e-11]"),
+    )
+    .unwrap();
+    let err = fail(&["--px4", &p], &dir.join("m4.toml"));
+    assert!(
+        err.contains("order 4") && err.contains("refit with order 3"),
+        "{err}"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -12,9 +12,12 @@
 //!   binned medians (robust to quantised temperature and uneven heating), hysteresis.
 //! * [`soak`]: the soak method — six-position + rate-table calibration at every set
 //!   temperature of a chamber recording, then a weighted fit of each bias and scale series.
+//! * [`autopilot`]: export of a model's bias part to PX4 `TC_*` and ArduPilot `INS_TCAL*`
+//!   parameter files, their import, and each autopilot's correction formula.
 //!
 //! Algorithms only: no file I/O here.
 
+pub mod autopilot;
 pub mod fit;
 pub mod model_file;
 pub mod ramp;

@@ -264,3 +264,82 @@ pub fn ramp_calibration(
         fits,
     })
 }
+
+impl RampCalibration {
+    /// A bias-only compensation model file from the fits (for `driftless compensate` and
+    /// the autopilot export, [`super::autopilot`]). `accel` / `gyro` give the channel
+    /// indices of the x, y, z axes (SI samples: m/s², rad/s); a triad not given gets no
+    /// thermal terms.
+    ///
+    /// * matrix = I, scale_delta = 0: a ramp sees no scale factor;
+    /// * bias_delta = the fit minus its constant (Δb(T) = ŷ(T) − ŷ(T_ref));
+    /// * gyro bias = the fitted value at T_ref (it includes the Earth-rate projection,
+    ///   ≤ 7.3e-5 rad/s, as the autopilots' own gyro calibrations do);
+    /// * accelerometer bias = 0: a static ramp cannot separate the bias from gravity (the
+    ///   fitted value at T_ref is mostly g along the axis), so the room offset must come
+    ///   from a regular accelerometer calibration — PX4's and ArduPilot's ramp
+    ///   calibrations likewise keep the accelerometer relative.
+    ///
+    /// Range: the temperatures of the bins; T_ref: the fits'; out of range: clamp.
+    pub fn bias_model_file(
+        &self,
+        accel: Option<[usize; 3]>,
+        gyro: Option<[usize; 3]>,
+        model_id: u64,
+    ) -> Result<super::model_file::ThermalModelFile, RampError> {
+        use super::model_file::{FORMAT_VERSION, ThermalModelFile, TriadSection};
+        let first = self
+            .fits
+            .first()
+            .ok_or_else(|| RampError::BadInput("no channel was fitted".into()))?;
+        let t_ref_c = first.poly.t_ref_c();
+        let lo = self
+            .points
+            .iter()
+            .map(|p| p.t_c)
+            .fold(f64::INFINITY, f64::min);
+        let hi = self
+            .points
+            .iter()
+            .map(|p| p.t_c)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let section = |idx: Option<[usize; 3]>,
+                       unit: &str,
+                       absolute: bool|
+         -> Result<TriadSection, RampError> {
+            let mut s = TriadSection {
+                raw_unit: unit.into(),
+                bias: [0.0; 3],
+                matrix: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                bias_delta: [vec![0.0], vec![0.0], vec![0.0]],
+                scale_delta: [vec![0.0], vec![0.0], vec![0.0]],
+            };
+            if let Some(idx) = idx {
+                for (k, &i) in idx.iter().enumerate() {
+                    let f = self.fits.get(i).ok_or_else(|| {
+                        RampError::BadInput(format!(
+                            "channel index {i} out of range ({} channels)",
+                            self.fits.len()
+                        ))
+                    })?;
+                    let mut c = f.coeffs.clone();
+                    if absolute {
+                        s.bias[k] = c[0];
+                    }
+                    c[0] = 0.0;
+                    s.bias_delta[k] = c;
+                }
+            }
+            Ok(s)
+        };
+        Ok(ThermalModelFile {
+            format_version: FORMAT_VERSION,
+            model_id,
+            t_ref_c,
+            range_c: [lo, hi],
+            out_of_range: "clamp".into(),
+            accel: section(accel, "m/s^2", false)?,
+            gyro: section(gyro, "rad/s", true)?,
+        })
+    }
+}
