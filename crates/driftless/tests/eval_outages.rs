@@ -47,7 +47,11 @@ fn position_and_heading_errors_are_exact_for_known_offsets() {
     let p = (LAT0, LON0, 1100.0);
     // Horizontal offsets: exact to 1e-8 m at 2 cm, 50 m and 5 km (ECEF rounding is
     // ~1e-9 m).
-    for d in [[30.0, -40.0, 0.0], [3000.0, 4000.0, 0.0], [-0.01, 0.02, 0.0]] {
+    for d in [
+        [30.0, -40.0, 0.0],
+        [3000.0, 4000.0, 0.0],
+        [-0.01, 0.02, 0.0],
+    ] {
         let e = position_error(p, displaced(p, d));
         let h = d[0].hypot(d[1]);
         assert!((e.ned_m[0] - d[0]).abs() < 1e-8, "{e:?} {d:?}");
@@ -63,7 +67,10 @@ fn position_and_heading_errors_are_exact_for_known_offsets() {
     }
     // A pure height offset: height error exact, no horizontal error.
     let e = position_error(p, (p.0, p.1, p.2 - 7.5));
-    assert!((e.height_m + 7.5).abs() < 1e-12 && e.horizontal_m < 1e-8, "{e:?}");
+    assert!(
+        (e.height_m + 7.5).abs() < 1e-12 && e.horizontal_m < 1e-8,
+        "{e:?}"
+    );
     assert!((e.ned_m[2] - 7.5).abs() < 1e-8);
     // A combined offset: the height error is −δD up to the curvature drop |δH|²/2R.
     let e = position_error(p, displaced(p, [30.0, -40.0, 5.0]));
@@ -91,7 +98,8 @@ fn straight_reference(t0: f64, n: usize) -> NavSolution {
         r.height_m.push(1100.0 + 0.1 * t);
         r.vel_ned_m_s.push([6.4, 8.0, -0.1]);
         let y = (170.0 + 0.5 * t).to_radians();
-        r.roll_pitch_yaw_rad.push([0.0, 0.0, driftless::eval::reference::wrap_pi(y)]);
+        r.roll_pitch_yaw_rad
+            .push([0.0, 0.0, driftless::eval::reference::wrap_pi(y)]);
     }
     r
 }
@@ -139,9 +147,17 @@ fn outage_errors_match_a_known_error_growth() {
     assert!((o.end_ned_m[2] - 3.0).abs() < 1e-6);
     // Height: −3 m plus the curvature drop of 450 m, 450²/(2R) ≈ 0.016 m.
     let drop = 450.0f64.powi(2) / (2.0 * 6.37e6);
-    assert!((o.end_height_m - (-3.0 + drop)).abs() < 1e-3, "{}", o.end_height_m);
+    assert!(
+        (o.end_height_m - (-3.0 + drop)).abs() < 1e-3,
+        "{}",
+        o.end_height_m
+    );
     // Heading: reference 170 + 35 = 205° = −155°, solution 207° → +2°, across ±180°.
-    assert!((o.end_heading_deg.unwrap() - 2.0).abs() < 1e-9, "{:?}", o.end_heading_deg);
+    assert!(
+        (o.end_heading_deg.unwrap() - 2.0).abs() < 1e-9,
+        "{:?}",
+        o.end_heading_deg
+    );
     assert!((o.max_horizontal_m - 450.0).abs() < 1e-6);
     assert_eq!(o.max_time_s, o.end_time_s);
     assert_eq!(o.epochs, 301);
@@ -203,12 +219,22 @@ fn metric_errors_name_the_window() {
     // Window ending after the reference.
     let e = outage_errors(&r, &s, &[w(40.0, 60.0)], &opts).unwrap_err();
     assert!(matches!(e, EvalError::NoReferenceAtEnd { .. }), "{e}");
-    assert!(e.to_string().contains("no reference at the end-of-outage epoch"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("no reference at the end-of-outage epoch"),
+        "{e}"
+    );
     // A NaN in the solution.
     s.lat_rad[5] = f64::NAN;
     let e = outage_errors(&r, &s, &[w(10.0, 20.0)], &opts).unwrap_err();
     assert!(
-        matches!(e, EvalError::BadTrajectory { which: "solution", .. }),
+        matches!(
+            e,
+            EvalError::BadTrajectory {
+                which: "solution",
+                ..
+            }
+        ),
         "{e}"
     );
     // Bad options.
@@ -352,10 +378,7 @@ fn agreement(
             inner_ok += usize::from(ok);
         }
     }
-    (
-        all_ok as f64 / all as f64,
-        inner_ok as f64 / inner as f64,
-    )
+    (all_ok as f64 / all as f64, inner_ok as f64 / inner as f64)
 }
 
 #[test]
@@ -389,7 +412,11 @@ fn classification_follows_the_segments_of_a_simulated_drive() {
         .collect();
     let mut noisy = sample_trajectory(&lv, &t4);
     let mut rng = Rng::seed_from_u64(7);
-    for (v, a) in noisy.vel_ned_m_s.iter_mut().zip(&mut noisy.roll_pitch_yaw_rad) {
+    for (v, a) in noisy
+        .vel_ned_m_s
+        .iter_mut()
+        .zip(&mut noisy.roll_pitch_yaw_rad)
+    {
         for x in v.iter_mut() {
             *x += 0.03 * rng.normal();
         }
@@ -403,7 +430,10 @@ fn classification_follows_the_segments_of_a_simulated_drive() {
         100.0 * all,
         100.0 * inner
     );
-    assert!(inner >= 0.97, "noisy agreement away from boundaries {inner}");
+    assert!(
+        inner >= 0.97,
+        "noisy agreement away from boundaries {inner}"
+    );
 }
 
 /// A long synthetic drive: `blocks` repetitions of stop, accelerate, cruise, turn,
@@ -502,7 +532,10 @@ fn selection_covers_every_class_keeps_spacing_and_is_deterministic() {
             .map(|d| format!("{d} {:.0}", secs[d.index()]))
             .collect::<Vec<_>>()
     );
-    assert!(secs.iter().all(|&s| s >= opts.min_class_s), "all five classes present");
+    assert!(
+        secs.iter().all(|&s| s >= opts.min_class_s),
+        "all five classes present"
+    );
 
     let sel = select_outages(&r, 7, 60.0, &opts).unwrap();
     print_selection("7x60", &sel);
@@ -599,7 +632,10 @@ fn bad_scenarios_fail_before_any_computation_with_their_error() {
     let msg = e.to_string();
     eprintln!("{msg}");
     assert!(matches!(e, EvalError::NotEnoughData { needed_s, .. } if needed_s == 1500.0));
-    assert!(msg.contains("9 outages of 60 s") && msg.contains("1500.0 s"), "{msg}");
+    assert!(
+        msg.contains("9 outages of 60 s") && msg.contains("1500.0 s"),
+        "{msg}"
+    );
     let bad = SelectOptions {
         min_gap_s: Some(-1.0),
         ..opts
@@ -631,7 +667,10 @@ fn bad_scenarios_fail_before_any_computation_with_their_error() {
         chk(&[w(100.0, 160.0), w(150.0, 210.0)]),
         Err(EvalError::Overlap { .. })
     ));
-    assert!(chk(&[w(100.0, 160.0), w(160.0, 220.0)]).is_ok(), "touching is allowed");
+    assert!(
+        chk(&[w(100.0, 160.0), w(160.0, 220.0)]).is_ok(),
+        "touching is allowed"
+    );
     assert!(matches!(
         chk(&[w(-10.0, 50.0)]),
         Err(EvalError::OutsideData { .. })
@@ -685,7 +724,14 @@ fn bad_scenarios_fail_before_any_computation_with_their_error() {
             length_s: 45.0
         }
     );
-    for bad in ["auto:0x60", "auto:9x0", "auto:9", "auto 9x60", "auto:ax60", "auto:9x-1"] {
+    for bad in [
+        "auto:0x60",
+        "auto:9x0",
+        "auto:9",
+        "auto 9x60",
+        "auto:ax60",
+        "auto:9x-1",
+    ] {
         let e = bad.parse::<OutageSpec>().unwrap_err();
         assert!(matches!(e, OutageError::Syntax { .. }), "{bad}: {e}");
     }
@@ -735,7 +781,12 @@ fn drive_0708_automatic_outages() {
     let dt = driftless::eval::reference::median_interval_s(&r.time_s);
     let secs: Vec<String> = Dynamics::ALL
         .iter()
-        .map(|&d| format!("{d} {:.0} s", c.iter().filter(|&&x| x == d).count() as f64 * dt))
+        .map(|&d| {
+            format!(
+                "{d} {:.0} s",
+                c.iter().filter(|&&x| x == d).count() as f64 * dt
+            )
+        })
         .collect();
     eprintln!(
         "drive_0708: {} fixes, {:.0} s; {}",
@@ -752,7 +803,10 @@ fn drive_0708_automatic_outages() {
         .unwrap();
     let sel = select_outages(&r, n, 60.0, &opts).unwrap();
     print_selection("drive_0708 default", &sel);
-    assert_eq!(n, 3, "549 s − 90 s of margins hold 3 × 60 s with 120-s gaps");
+    assert_eq!(
+        n, 3,
+        "549 s − 90 s of margins hold 3 × 60 s with 120-s gaps"
+    );
     let dense = SelectOptions {
         min_gap_s: Some(20.0),
         converge_s: 40.0,

@@ -364,7 +364,9 @@ mod tests {
         assert_eq!(c[150], Dynamics::Straight);
         assert_eq!(c[300], Dynamics::Turn);
         let m = ClassMix::of(&c[..]);
-        assert!((m.standstill + m.straight + m.turn + m.acceleration + m.braking - 1.0).abs() < 1e-12);
+        assert!(
+            (m.standstill + m.straight + m.turn + m.acceleration + m.braking - 1.0).abs() < 1e-12
+        );
     }
 
     #[test]

@@ -225,7 +225,11 @@ fn epoch_error(
 ) -> (PositionError, Option<f64>) {
     let e = position_error(
         (p.lat_rad, p.lon_rad, p.height_m),
-        (solution.lat_rad[k], solution.lon_rad[k], solution.height_m[k]),
+        (
+            solution.lat_rad[k],
+            solution.lon_rad[k],
+            solution.height_m[k],
+        ),
     );
     let ys = solution.roll_pitch_yaw_rad[k][2];
     let h = match (ys.is_finite(), p.yaw_rad) {
@@ -268,25 +272,25 @@ pub fn outage_errors(
         let (mut max_h, mut max_t, mut count) = (f64::NEG_INFINITY, t[end], 0usize);
         let mut growth = Vec::new();
         let mut next_mark = 0.0;
-        for k in i..=end {
-            let Some(p) = interpolate(reference, t[k], gap) else {
+        for (k, &tk) in t.iter().enumerate().take(end + 1).skip(i) {
+            let Some(p) = interpolate(reference, tk, gap) else {
                 continue;
             };
             let h = epoch_error(&p, solution, k).0.horizontal_m;
             count += 1;
             if h > max_h {
                 max_h = h;
-                max_t = t[k];
+                max_t = tk;
             }
-            let since = t[k] - w.start_s;
+            let since = tk - w.start_s;
             if k == end || since >= next_mark - 1e-9 {
                 growth.push(GrowthPoint {
                     since_start_s: since,
                     horizontal_m: h,
                 });
                 if opts.growth_step_s > 0.0 {
-                    next_mark = ((since / opts.growth_step_s + 1e-9).floor() + 1.0)
-                        * opts.growth_step_s;
+                    next_mark =
+                        ((since / opts.growth_step_s + 1e-9).floor() + 1.0) * opts.growth_step_s;
                 }
             }
         }

@@ -19,7 +19,7 @@
 //! Conventions: SI inside (s, m, rad); results carry display units in their field names
 //! (`end_horizontal_m`, `end_heading_deg`). Times are GPS seconds of week, the time
 //! column of the trajectories. A window is the closed interval of
-//! [`OutageWindow`](crate::nav::outage::OutageWindow).
+//! [`OutageWindow`].
 
 pub mod dynamics;
 pub mod metrics;
@@ -120,7 +120,9 @@ pub enum EvalError {
         window: OutageWindow,
     },
     /// A given window is longer than the reference.
-    #[error("outage window {window} lasts {length_s} s, longer than the reference data ({data_s} s)")]
+    #[error(
+        "outage window {window} lasts {length_s} s, longer than the reference data ({data_s} s)"
+    )]
     WindowLongerThanData {
         /// The window.
         window: OutageWindow,
@@ -130,7 +132,9 @@ pub enum EvalError {
         data_s: f64,
     },
     /// A given window is not inside the reference.
-    #[error("outage window {window} lies outside the reference data [{start_s} s, {end_s} s]: {reason}")]
+    #[error(
+        "outage window {window} lies outside the reference data [{start_s} s, {end_s} s]: {reason}"
+    )]
     OutsideData {
         /// The window.
         window: OutageWindow,

@@ -23,6 +23,7 @@
 use crate::io::nav::{GnssFixes, NavSolution};
 use crate::nav::attitude::Euler;
 use crate::nav::earth::ned_offset_m;
+use crate::nav::mechanization::NavState;
 use crate::sim::ideal_imu::Trajectory;
 use driftless_model::linalg::Vec3;
 
@@ -70,9 +71,7 @@ pub fn validate(t: &NavSolution, which: &'static str) -> Result<(), EvalError> {
         ("roll_pitch_yaw_rad", t.roll_pitch_yaw_rad.len()),
     ] {
         if len != n {
-            return Err(bad(format!(
-                "column {name} has {len} rows, time_s has {n}"
-            )));
+            return Err(bad(format!("column {name} has {len} rows, time_s has {n}")));
         }
     }
     for k in 0..n {
@@ -152,7 +151,26 @@ pub fn sample_trajectory<T: Trajectory + ?Sized>(traj: &T, times_s: &[f64]) -> N
         s.lon_rad.push(p.lon_rad);
         s.height_m.push(p.height_m);
         s.vel_ned_m_s.push(p.vel_ned_m_s);
-        s.roll_pitch_yaw_rad.push([e.roll_rad, e.pitch_rad, e.yaw_rad]);
+        s.roll_pitch_yaw_rad
+            .push([e.roll_rad, e.pitch_rad, e.yaw_rad]);
+    }
+    s
+}
+
+/// A filter's or smoother's states as a trajectory to score (IMU centre; Euler angles
+/// of q_bn): `from_nav_states(run.epochs.iter().map(|e| &e.nav))` for a forward run,
+/// the same over `SmoothedRun::epochs` for the smoothed one.
+pub fn from_nav_states<'a>(states: impl IntoIterator<Item = &'a NavState>) -> NavSolution {
+    let mut s = NavSolution::default();
+    for n in states {
+        let e = Euler::from_dcm(&n.q_bn.to_dcm());
+        s.time_s.push(n.time_s);
+        s.lat_rad.push(n.lat_rad);
+        s.lon_rad.push(n.lon_rad);
+        s.height_m.push(n.height_m);
+        s.vel_ned_m_s.push(n.vel_ned_m_s);
+        s.roll_pitch_yaw_rad
+            .push([e.roll_rad, e.pitch_rad, e.yaw_rad]);
     }
     s
 }
@@ -236,7 +254,8 @@ mod tests {
             let t = 100.0 + k as f64;
             s.time_s.push(t);
             s.lat_rad.push(0.5 + 1e-6 * k as f64);
-            s.lon_rad.push(std::f64::consts::PI - 2e-6 + 1e-6 * k as f64);
+            s.lon_rad
+                .push(std::f64::consts::PI - 2e-6 + 1e-6 * k as f64);
             s.height_m.push(10.0 + 0.5 * k as f64);
             s.vel_ned_m_s.push([6.0, 4.0, -0.5]);
             s.roll_pitch_yaw_rad

@@ -99,7 +99,13 @@ impl SelectOptions {
     }
 
     fn check(&self, length_s: f64) -> Result<(), EvalError> {
-        let bad = |name, value, reason| Err(EvalError::BadOption { name, value, reason });
+        let bad = |name, value, reason| {
+            Err(EvalError::BadOption {
+                name,
+                value,
+                reason,
+            })
+        };
         let nonneg = "must be a finite number ≥ 0";
         for (name, v) in [
             ("min_gap_s", self.gap_s(length_s)),
@@ -200,7 +206,12 @@ impl Timeline {
         None
     }
 
-    fn describe(&self, w: OutageWindow, chosen_for: Option<Dynamics>, prev_end: f64) -> SelectedOutage {
+    fn describe(
+        &self,
+        w: OutageWindow,
+        chosen_for: Option<Dynamics>,
+        prev_end: f64,
+    ) -> SelectedOutage {
         let (i, j) = self.range(w.start_s, w.end_s);
         let mix = ClassMix::from_counts(self.counts(i, j));
         SelectedOutage {
@@ -340,7 +351,11 @@ pub fn select_outages(
                 Some(d) => {
                     let c = shares[i];
                     let n: usize = c.iter().sum();
-                    if n == 0 { 0.0 } else { c[d.index()] as f64 / n as f64 }
+                    if n == 0 {
+                        0.0
+                    } else {
+                        c[d.index()] as f64 / n as f64
+                    }
                 }
                 None => 0.0,
             };
@@ -496,9 +511,7 @@ pub fn resolve_outages(
 ) -> Result<Vec<SelectedOutage>, EvalError> {
     match spec {
         OutageSpec::None => Ok(Vec::new()),
-        OutageSpec::Auto { count, length_s } => {
-            select_outages(reference, *count, *length_s, opts)
-        }
+        OutageSpec::Auto { count, length_s } => select_outages(reference, *count, *length_s, opts),
         other => {
             validate(reference, "reference")?;
             let (t0, t1) = span_of(reference);
