@@ -556,7 +556,7 @@ fn selection_covers_every_class_keeps_spacing_and_is_deterministic() {
         let m = s.mix;
         let sum = m.standstill + m.straight + m.turn + m.acceleration + m.braking;
         assert!((sum - 1.0).abs() < 1e-12);
-        // The window placed for a class holds the largest share of it any start has.
+        // A window placed for a class contains some of it.
         if let Some(d) = s.chosen_for {
             assert!(s.mix.get(d) > 0.0);
         }
