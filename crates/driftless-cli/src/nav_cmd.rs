@@ -7,10 +7,12 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use driftless::eval::SelectedOutage;
+use driftless::io::nav::GnssFixes;
 use driftless::io::nav::kfgins::GnssReadOptions;
 use driftless::io::nav::read_kfgins_imu_file;
 use driftless::nav::filter::model::{FilterConfig, GaussMarkov, ImuNoise};
-use driftless::nav::outage::OutageSpec;
+use driftless::nav::outage::{OutageItem, OutageSpec, OutageStart};
 use driftless::nav::pipeline::{
     GnssOutsideImu, ImuGapPolicy, ImuStreamOptions, RateChannels, TaggedCsvOptions,
     imu_from_kfgins, imu_from_rates_log, imu_from_tagged_csv_files, read_gnss_file, select_gnss,
@@ -72,7 +74,9 @@ pub struct NavArgs {
     #[arg(long)]
     pub noise_model: Option<PathBuf>,
     /// GNSS outages: `none`, `300+60,600+60` (s after the first fix), `@243600+60`
-    /// (absolute), or `6x60s every 85s from 50s`.
+    /// (absolute), `6x60s every 85s from 50s`, or `auto:9x60` (nine 60-s windows chosen
+    /// on the GNSS track to cover straight runs, turns, accelerations, braking and stops,
+    /// at least max(2·60, 120) s apart, 60 s after the first fix and 30 s before the last).
     #[arg(long, default_value = "none")]
     pub outages: String,
     /// Folder for KF-GINS-format output files.
@@ -193,6 +197,7 @@ pub fn run(a: NavArgs) -> Result<()> {
     };
     let spec: OutageSpec = a.outages.parse().context("--outages")?;
     let all = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)?;
+    let (spec, selection) = choose_outages(spec, &all.fixes)?;
     let windows = select_gnss(&gnss, &imu, &spec, GnssOutsideImu::Drop)?.windows;
     let mut cfg = match a.preset {
         Some(Preset::Drive0708) => SessionConfig::drive_0708(),
@@ -236,6 +241,7 @@ pub fn run(a: NavArgs) -> Result<()> {
                 "end_vertical_m": o.end_vertical_m,
             })).collect::<Vec<_>>(),
             "mean_end_horizontal_m": mean_end,
+            "outage_selection": selection,
             "smoothed_outages": res.smoothed_outages.as_ref().map(|v| v.iter().map(|o| serde_json::json!({
                 "start_s": o.window.start_s, "end_s": o.window.end_s,
                 "end_horizontal_m": o.end_horizontal_m, "max_horizontal_m": o.max_horizontal_m,
@@ -257,6 +263,9 @@ pub fn run(a: NavArgs) -> Result<()> {
     );
     if let Some((rms, n)) = res.horizontal_rms_m {
         println!("full-GNSS horizontal one-step prediction error: RMS {rms:.3} m over {n} fixes");
+    }
+    if let Some(sel) = &selection {
+        print!("{}", selection_table(sel));
     }
     if !res.outages.is_empty() {
         let mut t = crate::output::Table::new([
@@ -294,6 +303,55 @@ pub fn run(a: NavArgs) -> Result<()> {
         println!("KF-GINS-format outputs written to {}", dir.display());
     }
     Ok(())
+}
+
+/// `auto:NxL` outages: chosen on the GNSS fixes inside the IMU span (the drive's only
+/// reference) before any filtering, so an impossible request fails at once; returned as
+/// absolute windows. Other specifications pass through unchanged.
+fn choose_outages(
+    spec: OutageSpec,
+    fixes: &GnssFixes,
+) -> Result<(OutageSpec, Option<Vec<SelectedOutage>>)> {
+    if !matches!(spec, OutageSpec::Auto { .. }) {
+        return Ok((spec, None));
+    }
+    let reference = driftless::eval::reference::reference_from_fixes(fixes)
+        .context("--outages auto: the GNSS fixes as reference")?;
+    let sel = driftless::eval::resolve_outages(
+        &spec,
+        &reference,
+        &driftless::eval::SelectOptions::default(),
+    )
+    .context("--outages")?;
+    let items = sel
+        .iter()
+        .map(|s| OutageItem {
+            start: OutageStart::Gps(s.window.start_s),
+            length_s: s.window.duration_s(),
+        })
+        .collect();
+    Ok((OutageSpec::Windows(items), Some(sel)))
+}
+
+/// The automatically chosen windows and the dynamics inside them.
+fn selection_table(sel: &[SelectedOutage]) -> String {
+    let mut t = crate::output::Table::new([
+        "outage",
+        "start [s]",
+        "end [s]",
+        "chosen for",
+        "dynamics inside",
+    ]);
+    for (i, s) in sel.iter().enumerate() {
+        t.row(vec![
+            format!("#{}", i + 1),
+            format!("{:.1}", s.window.start_s),
+            format!("{:.1}", s.window.end_s),
+            s.chosen_for.map_or("–".into(), |d| d.to_string()),
+            s.mix.to_string(),
+        ]);
+    }
+    format!("automatic outages:\n{}", t.render())
 }
 
 /// `--kf-gins CONFIG`: the KF-GINS job, forward filter only (KF-GINS has no smoother).
@@ -416,6 +474,11 @@ pub fn kf_gins_job(
     }
     let spec: OutageSpec = outages.parse().context("--outages")?;
     if spec != OutageSpec::None {
+        let in_span = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)?;
+        let (spec, selection) = choose_outages(spec, &in_span.fixes)?;
+        if let (true, Some(sel)) = (verbose, &selection) {
+            eprint!("{}", selection_table(sel));
+        }
         let sel = select_gnss(&gnss, &imu, &spec, GnssOutsideImu::Drop)?;
         cfg.outages_s = sel.windows.iter().map(|w| (w.start_s, w.end_s)).collect();
     }

@@ -291,3 +291,71 @@ fn generic_rate_csv_runs() {
     assert!(err.contains("bad.csv"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `driftless nav --outages auto:NxL`: windows chosen on the GNSS track before the
+/// filter runs; a request that cannot fit fails at once with the arithmetic.
+#[test]
+fn auto_outages_are_chosen_on_the_track_or_refused() {
+    let dir = std::env::temp_dir().join(format!("driftless-navauto-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let t0 = 356_400.0;
+    let turn = turn();
+    let dt = 0.005;
+    let n = 24_000;
+    let incs: Vec<_> = ideal_increments(&turn, dt, dt, n).collect();
+    let imu = ImuIncrements {
+        time_s: (0..n).map(|k| t0 + (k + 1) as f64 * dt).collect(),
+        dtheta_rad: incs.iter().map(|i| i.dtheta_rad).collect(),
+        dvel_m_s: incs.iter().map(|i| i.dvel_m_s).collect(),
+    };
+    let file = |p: &str| std::fs::File::create(dir.join(p)).unwrap();
+    write_kfgins_imu(file("imu.txt"), "imu.txt", &imu).unwrap();
+    write_kfgins_gnss(file("gnss.txt"), "gnss.txt", &turn_fixes(&turn, t0)).unwrap();
+    let base = ["nav", "--imu", "imu.txt", "--gnss", "gnss.txt", "--json"];
+
+    // 118 s of fixes: nine 60-s outages cannot fit, and the message says why.
+    let started = std::time::Instant::now();
+    let bad = bin()
+        .current_dir(&dir)
+        .args(base)
+        .args(["--outages", "auto:9x60"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(bad.stdout.is_empty());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    eprintln!("{err}");
+    assert!(
+        err.contains("9 outages of 60 s") && err.contains("1500.0 s"),
+        "{err}"
+    );
+    eprintln!("refused after {:.2} s", started.elapsed().as_secs_f64());
+
+    // One 20-s outage fits in the usable [t0 + 61, t0 + 89] s.
+    let ok = bin()
+        .current_dir(&dir)
+        .args(base)
+        .args(["--outages", "auto:1x20"])
+        .output()
+        .unwrap();
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&ok.stdout).unwrap();
+    let sel = v["outage_selection"].as_array().unwrap();
+    assert_eq!(sel.len(), 1);
+    let start = sel[0]["window"]["start_s"].as_f64().unwrap();
+    let end = sel[0]["window"]["end_s"].as_f64().unwrap();
+    assert!(
+        start >= t0 + 61.0 - 1e-9 && end <= t0 + 89.0 + 1e-9,
+        "{start} {end}"
+    );
+    // A 2°/s turn is below the 5°/s turn threshold: straight driving.
+    assert_eq!(sel[0]["chosen_for"], "straight");
+    assert_eq!(v["outages"].as_array().unwrap().len(), 1);
+    assert_eq!(v["outages"][0]["start_s"].as_f64().unwrap(), start);
+    assert!(v["outages"][0]["end_horizontal_m"].as_f64().is_some());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -11,6 +11,7 @@
 
 pub mod allan;
 pub mod calib;
+pub mod eval;
 pub mod io;
 pub mod nav;
 pub mod report;

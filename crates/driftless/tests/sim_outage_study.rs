@@ -12,9 +12,11 @@
 //! GNSS position updates; nine 60-s outages starting at t0 + 300, 600, …, 2700 s (no fix
 //! strictly inside (a, a + 60 s): exactly 60 s of free inertial navigation between the
 //! fix at a and the fix at a + 60 s). Then the RTS smoother. Errors are measured against
-//! the truth trajectory (not the noisy fixes): full-GNSS horizontal RMS over every 200-Hz
-//! epoch from t0 + 60 s on outside the outage windows; per outage the horizontal error at
-//! the last epoch before the first fix after the window.
+//! the truth trajectory (not the noisy fixes) with `driftless::eval::metrics` (exact
+//! ECEF → local-NED horizontal error; the truth sampled at the filter's epochs):
+//! full-GNSS horizontal RMS over every 200-Hz epoch from t0 + 60 s on outside the outage
+//! windows; per outage the horizontal error at the last epoch before the first fix after
+//! the window, and the largest error from the outage start to that epoch.
 //!
 //! Two runs on the same data:
 //!
@@ -57,21 +59,22 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use driftless::eval::metrics::{MetricOptions, horizontal_errors, outage_errors};
+use driftless::eval::reference::{from_nav_states, sample_trajectory};
 use driftless::io::nav::{GnssFixes, GnssReadOptions, read_kfgins_gnss_file};
-use driftless::nav::earth;
 use driftless::nav::filter::{
     FilterConfig, GaussMarkov, ImuNoise, InitialState, NhcConfig, SensorErrors, UpdateKind,
     run_forward, smooth,
 };
-use driftless::nav::mechanization::{ImuIncrement, NavState};
+use driftless::nav::mechanization::ImuIncrement;
+use driftless::nav::outage::OutageWindow;
 use driftless::sim::gnss::{GnssSimConfig, simulate_gnss};
-use driftless::sim::ideal_imu::{Trajectory, TrajectoryPoint};
+use driftless::sim::ideal_imu::Trajectory;
 use driftless::sim::presets::Preset;
 use driftless::sim::recorded::{RecordedOptions, RecordedTrajectory};
 use driftless::sim::sensor::{IdealImu, OutputKind, SensorModel};
 use driftless::sim::temperature::TemperatureProfile;
 use driftless_model::units::DEG;
-use rayon::prelude::*;
 
 fn data(rel: &str) -> PathBuf {
     match std::env::var_os("DRIFTLESS_DATA") {
@@ -126,14 +129,6 @@ fn imu_noise() -> ImuNoise {
     }
 }
 
-fn horizontal_error(nav: &NavState, truth: &TrajectoryPoint) -> f64 {
-    let d = earth::ned_offset_m(
-        (truth.lat_rad, truth.lon_rad, truth.height_m),
-        (nav.lat_rad, nav.lon_rad, nav.height_m),
-    );
-    d[0].hypot(d[1])
-}
-
 /// The figures of one run.
 struct Figures {
     rms_m: f64,
@@ -163,21 +158,12 @@ fn study(
     let t_sm = c.elapsed().as_secs_f64();
     assert_eq!(sm.epochs.len(), run.epochs.len());
 
-    // (time, forward horizontal error, smoothed horizontal error) per epoch.
-    let errs: Vec<(f64, f64, f64)> = run
-        .epochs
-        .par_iter()
-        .zip(sm.epochs.par_iter())
-        .map(|(f, s)| {
-            let t = f.nav.time_s;
-            let p = traj.point(t);
-            (
-                t,
-                horizontal_error(&f.nav, &p),
-                horizontal_error(&s.nav, &p),
-            )
-        })
-        .collect();
+    // Both passes as trajectories, and the truth sampled at their epochs (so the
+    // metrics' interpolation returns the truth itself).
+    let fwd = from_nav_states(run.epochs.iter().map(|e| &e.nav));
+    let smo = from_nav_states(sm.epochs.iter().map(|e| &e.nav));
+    let truth = sample_trajectory(traj, &fwd.time_s);
+    let fwd_h = horizontal_errors(&truth, &fwd, 1.0).expect("forward errors");
 
     // Full GNSS: every epoch from t0 + 60 s on, outside (a, a + 60 s) of every outage
     // (the epoch of the fix at a + 60 s is post-update).
@@ -187,18 +173,20 @@ fn study(
             .any(|&a| t > a + 1e-6 && t < a + OUTAGE_S - 1e-6)
     };
     let (mut ss, mut cnt) = (0.0, 0usize);
-    for &(t, h, _) in errs.iter().filter(|e| e.0 >= t0 + CONVERGE_S) {
-        if !in_outage(t) {
+    for (&t, h) in fwd.time_s.iter().zip(&fwd_h) {
+        if t >= t0 + CONVERGE_S && !in_outage(t) {
+            let h = h.expect("truth at every epoch");
             ss += h * h;
             cnt += 1;
         }
     }
     let rms_m = (ss / cnt as f64).sqrt();
 
-    // Per outage: the error at the last epoch before the first GNSS update after the
-    // window, the filter's horizontal σ there, and the largest error inside the window
-    // of both passes.
-    let (mut end_m, mut sigma_m, mut max_fwd, mut max_sm) = (vec![], vec![], vec![], vec![]);
+    // Per outage: the window runs from the outage start to the last epoch before the
+    // first GNSS update after it (the end-of-outage epoch); the filter's horizontal σ
+    // there; the largest error inside the window of both passes.
+    let mut windows = Vec::new();
+    let mut sigma_m = Vec::new();
     for &a in starts {
         let u = run
             .updates
@@ -213,23 +201,31 @@ fn study(
             u.time_s
         );
         let k = u.epoch_index - 1;
-        end_m.push(errs[k].1);
+        windows.push(OutageWindow {
+            start_s: a,
+            end_s: run.epochs[k].nav.time_s,
+        });
         let sd = run.epochs[k].std;
         sigma_m.push(sd[0].hypot(sd[1]));
-        let (mf, ms) = errs
-            .iter()
-            .filter(|e| e.0 > a && e.0 <= errs[k].0)
-            .fold((0.0f64, 0.0f64), |(x, y), e| (x.max(e.1), y.max(e.2)));
-        max_fwd.push(mf);
-        max_sm.push(ms);
     }
+    let opts = MetricOptions::default();
+    let f_rep = outage_errors(&truth, &fwd, &windows, &opts).expect("forward outage errors");
+    let s_rep = outage_errors(&truth, &smo, &windows, &opts).expect("smoothed outage errors");
+    let end_m: Vec<f64> = f_rep.outages.iter().map(|o| o.end_horizontal_m).collect();
+    let max_fwd: Vec<f64> = f_rep.outages.iter().map(|o| o.max_horizontal_m).collect();
+    let max_sm: Vec<f64> = s_rep.outages.iter().map(|o| o.max_horizontal_m).collect();
+    let (fe, fm, sx) = (
+        f_rep.summary.end_horizontal_m.expect("outages"),
+        f_rep.summary.max_horizontal_m.expect("outages"),
+        s_rep.summary.max_horizontal_m.expect("outages"),
+    );
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
     let fig = Figures {
         rms_m,
-        end_mean_m: mean(&end_m),
-        end_max_m: end_m.iter().copied().fold(0.0, f64::max),
-        fwd_in_max_mean_m: mean(&max_fwd),
-        sm_in_max_mean_m: mean(&max_sm),
+        end_mean_m: fe.mean,
+        end_max_m: fe.max,
+        fwd_in_max_mean_m: fm.mean,
+        sm_in_max_mean_m: sx.mean,
         end_m,
     };
 

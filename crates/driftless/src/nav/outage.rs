@@ -18,6 +18,11 @@
 //!   GNSS epoch (`START` defaults to `PERIOD`, so the filter first converges for one
 //!   period). `×` may be written for `x`. Example: `9x60s every 300s from 300s` gives
 //!   windows starting at 300, 600, …, 2700 s.
+//! * **Automatic**: `auto:N x LENGTH` (`auto:9x60`, `auto: 9 × 60s`) — `N` windows of
+//!   `LENGTH` seconds chosen on a reference trajectory to cover the vehicle's dynamics
+//!   (`crate::eval::select::select_outages`). Parsing only records the request: [`resolve`]
+//!   cannot place them without the reference and says so
+//!   ([`OutageError::NeedsReference`]); `crate::eval::select::resolve_outages` does.
 //!
 //! # Validation
 //!
@@ -38,8 +43,10 @@
 use std::fmt;
 use std::str::FromStr;
 
+use serde::{Deserialize, Serialize};
+
 /// One outage in absolute GPS time (seconds of week of the GNSS data), closed interval.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct OutageWindow {
     /// First withheld instant, GPS s of week.
     pub start_s: f64,
@@ -101,6 +108,14 @@ pub enum OutageSpec {
         /// First start, s after the first GNSS epoch (≥ 0).
         start_s: f64,
     },
+    /// `count` windows of `length_s` chosen on a reference trajectory
+    /// (`crate::eval::select::select_outages`).
+    Auto {
+        /// Number of windows (≥ 1).
+        count: usize,
+        /// Length of each window, s (> 0).
+        length_s: f64,
+    },
 }
 
 /// The GNSS time span outages are resolved against: first and last GNSS epoch, GPS s.
@@ -131,7 +146,7 @@ impl TimeSpan {
 pub enum OutageError {
     /// The text does not follow the grammar.
     #[error(
-        "bad outage specification {text:?}: {reason} (expected e.g. \"300+60,600+60\", \"@243600+60\" or \"9x60s every 300s from 300s\")"
+        "bad outage specification {text:?}: {reason} (expected e.g. \"300+60,600+60\", \"@243600+60\", \"9x60s every 300s from 300s\" or \"auto:9x60\")"
     )]
     Syntax {
         /// The whole specification.
@@ -166,6 +181,17 @@ pub enum OutageError {
         span: TimeSpan,
         /// Which end is outside.
         reason: &'static str,
+    },
+    /// `auto:NxL` needs a reference trajectory to choose its windows from.
+    #[error(
+        "outages \"auto:{count}x{length_s}\" are chosen on a reference trajectory: resolve them \
+         with driftless::eval::select::resolve_outages, not against a bare time span"
+    )]
+    NeedsReference {
+        /// Windows asked for.
+        count: usize,
+        /// Their length, s.
+        length_s: f64,
     },
     /// The GNSS span itself is unusable (empty, non-finite or reversed).
     #[error("cannot place outages: GNSS time span [{} s, {} s] is empty or invalid", span.start_s, span.end_s)]
@@ -215,6 +241,9 @@ impl FromStr for OutageSpec {
         if norm.is_empty() || norm == "none" {
             return Ok(OutageSpec::None);
         }
+        if let Some(rest) = norm.strip_prefix("auto") {
+            return parse_auto(text, rest);
+        }
         let tokens: Vec<&str> = norm.split_whitespace().collect();
         if let Some(every) = tokens.iter().position(|&t| t == "every") {
             return parse_generator(text, &tokens, every);
@@ -251,6 +280,33 @@ impl FromStr for OutageSpec {
         }
         Ok(OutageSpec::Windows(items))
     }
+}
+
+/// `auto:COUNTxLENGTH`, `rest` the lower-case text after `auto`.
+fn parse_auto(text: &str, rest: &str) -> Result<OutageSpec, OutageError> {
+    let body: String = rest
+        .trim_start()
+        .strip_prefix(':')
+        .ok_or_else(|| syntax(text, "expected \"auto:COUNTxLENGTH\", e.g. \"auto:9x60\""))?
+        .split_whitespace()
+        .collect();
+    let Some((n, length)) = body.split_once('x') else {
+        return Err(syntax(
+            text,
+            format!("{body:?} after \"auto:\" is not COUNTxLENGTH"),
+        ));
+    };
+    let count = match n.parse::<usize>() {
+        Ok(c) if c > 0 => c,
+        _ => {
+            return Err(syntax(
+                text,
+                format!("count {n:?} must be a whole number ≥ 1"),
+            ));
+        }
+    };
+    let length_s = positive(seconds(length, "length", text)?, length, "length", text)?;
+    Ok(OutageSpec::Auto { count, length_s })
 }
 
 /// `N x LENGTH every PERIOD [from START]`, tokens already lower-case and split on spaces.
@@ -317,13 +373,20 @@ impl OutageSpec {
 /// Turns a specification into absolute, sorted, validated windows for GNSS data whose
 /// first and last epochs are `span` (GPS s of week). Errors: invalid span; a window longer
 /// than the span; a window starting before the first or ending after the last epoch; two
-/// windows overlapping (touching is allowed).
+/// windows overlapping (touching is allowed); `auto:` windows, which need a reference
+/// trajectory ([`OutageError::NeedsReference`]).
 pub fn resolve(spec: &OutageSpec, span: TimeSpan) -> Result<Vec<OutageWindow>, OutageError> {
     if !(span.start_s.is_finite() && span.end_s.is_finite() && span.end_s > span.start_s) {
         return Err(OutageError::BadSpan { span });
     }
     let mut windows: Vec<OutageWindow> = match spec {
         OutageSpec::None => Vec::new(),
+        OutageSpec::Auto { count, length_s } => {
+            return Err(OutageError::NeedsReference {
+                count: *count,
+                length_s: *length_s,
+            });
+        }
         OutageSpec::Windows(items) => items
             .iter()
             .map(|it| {
