@@ -334,3 +334,68 @@ fn run(seed: u64, all_terms: bool) -> Run {
         compensated_fraction: rc / rr,
     }
 }
+
+/// Bad input: a temperature step that lacks one of the six positions is refused naming
+/// the temperature and the count of positions; fewer set temperatures than the order
+/// needs are refused naming both.
+#[test]
+fn a_temperature_missing_a_position_is_refused() {
+    let proto = ChamberConfig {
+        temperatures_c: vec![0.0, 20.0, 40.0, 60.0, 10.0],
+        soak_s: 60.0,
+        lag_tau_s: 5.0,
+        position_dwell_s: 5.0,
+        move_s: 2.0,
+        rate_revolutions: 1,
+        spin_s: 1.0,
+        sample_rate_hz: 50.0,
+        ..ChamberConfig::default()
+    }
+    .build()
+    .expect("protocol");
+    let cfg = Preset::AdiLike.config().deterministic_only();
+    let curve = proto.temperature.curve().expect("temperature");
+    let out = SensorModel::new(cfg)
+        .expect("model")
+        .simulate(&proto.ideal(OutputKind::Rates), &curve, 1)
+        .expect("simulate");
+    let six = SixPositionOptions::from_manifest(&proto.manifest);
+    let soak = |manifest: &driftless::sim::chamber_manifest::ChamberManifest, order: usize| {
+        soak_calibration(
+            manifest,
+            out.accel.each_ref().map(Vec::as_slice),
+            out.gyro.each_ref().map(Vec::as_slice),
+            1.0,
+            &six,
+            &FitOptions {
+                order,
+                ..FitOptions::default()
+            },
+            None,
+        )
+    };
+    // Unsorted set temperatures are fine (sorted internally).
+    let ok = soak(&proto.manifest, 3).expect("complete protocol");
+    assert_eq!(ok.temperatures_c, vec![0.0, 10.0, 20.0, 40.0, 60.0]);
+    // Drop the last static position at 40 °C.
+    let mut m = proto.manifest.clone();
+    let i = m
+        .segments
+        .iter()
+        .rposition(|g| {
+            g.set_temperature_c == 40.0 && matches!(g.kind, SegmentKind::Position { .. })
+        })
+        .expect("a position at 40 °C");
+    m.segments.remove(i);
+    let e = soak(&m, 3).unwrap_err().to_string();
+    assert!(
+        e.contains("at 40 °C") && e.contains("5 static positions"),
+        "{e}"
+    );
+    // Order 4 from 5 temperatures: refused (needs order + 2 for a residual).
+    let e = soak(&proto.manifest, 4).unwrap_err().to_string();
+    assert!(
+        e.contains("5 set temperatures") && e.contains("order-4"),
+        "{e}"
+    );
+}
