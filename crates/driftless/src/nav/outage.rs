@@ -282,6 +282,22 @@ impl FromStr for OutageSpec {
     }
 }
 
+/// The `COUNT` and `LENGTH` of a `COUNTxLENGTH` pair: a whole count ≥ 1 and a positive
+/// duration.
+fn count_and_length(text: &str, n: &str, length: &str) -> Result<(usize, f64), OutageError> {
+    let count = match n.parse::<usize>() {
+        Ok(c) if c > 0 => c,
+        _ => {
+            return Err(syntax(
+                text,
+                format!("count {n:?} must be a whole number ≥ 1"),
+            ));
+        }
+    };
+    let length_s = positive(seconds(length, "length", text)?, length, "length", text)?;
+    Ok((count, length_s))
+}
+
 /// `auto:COUNTxLENGTH`, `rest` the lower-case text after `auto`.
 fn parse_auto(text: &str, rest: &str) -> Result<OutageSpec, OutageError> {
     let body: String = rest
@@ -296,16 +312,7 @@ fn parse_auto(text: &str, rest: &str) -> Result<OutageSpec, OutageError> {
             format!("{body:?} after \"auto:\" is not COUNTxLENGTH"),
         ));
     };
-    let count = match n.parse::<usize>() {
-        Ok(c) if c > 0 => c,
-        _ => {
-            return Err(syntax(
-                text,
-                format!("count {n:?} must be a whole number ≥ 1"),
-            ));
-        }
-    };
-    let length_s = positive(seconds(length, "length", text)?, length, "length", text)?;
+    let (count, length_s) = count_and_length(text, n, length)?;
     Ok(OutageSpec::Auto { count, length_s })
 }
 
@@ -318,16 +325,7 @@ fn parse_generator(text: &str, tokens: &[&str], every: usize) -> Result<OutageSp
             format!("{head:?} before \"every\" is not COUNTxLENGTH"),
         ));
     };
-    let count = match n.parse::<usize>() {
-        Ok(c) if c > 0 => c,
-        _ => {
-            return Err(syntax(
-                text,
-                format!("count {n:?} must be a whole number ≥ 1"),
-            ));
-        }
-    };
-    let length_s = positive(seconds(length, "length", text)?, length, "length", text)?;
+    let (count, length_s) = count_and_length(text, n, length)?;
     let rest = &tokens[every + 1..];
     let (period, start) = match rest {
         [p] => (*p, None),

@@ -651,6 +651,23 @@ fn fields(line: &str, is_sep: impl Fn(char) -> bool) -> Vec<(usize, &str)> {
     out
 }
 
+
+/// A parameter name field (column, text): letters, digits and `_` only.
+fn parameter_name<'a>(
+    file: &str,
+    line: usize,
+    (col, name): (usize, &'a str),
+) -> Result<&'a str, AutopilotError> {
+    if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(syntax(
+            file,
+            line,
+            col,
+            format!("{name:?} is not a parameter name"),
+        ));
+    }
+    Ok(name)
+}
 /// Column to blame for a wrong field count: the first extra field, or just past the end.
 fn count_column(line: &str, f: &[(usize, &str)], want: usize) -> usize {
     f.get(want).map_or(line.chars().count() + 1, |x| x.0)
@@ -914,15 +931,7 @@ pub fn parse_px4(text: &str, file: &str, instance: usize) -> Result<Px4Thermal, 
                 ));
             }
         }
-        let (ncol, name) = f[2];
-        if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            return Err(syntax(
-                file,
-                line,
-                ncol,
-                format!("{name:?} is not a parameter name"),
-            ));
-        }
+        let name = parameter_name(file, line, f[2])?;
         let (vcol, vtext) = f[3];
         let value = parse_number(file, line, vcol, vtext)?;
         let (tcol, ttext) = f[4];
@@ -1164,15 +1173,7 @@ pub fn parse_ardupilot(
                 format!("expected `NAME,VALUE`, found {} fields", f.len()),
             ));
         }
-        let (ncol, name) = f[0];
-        if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            return Err(syntax(
-                file,
-                line,
-                ncol,
-                format!("{name:?} is not a parameter name"),
-            ));
-        }
+        let name = parameter_name(file, line, f[0])?;
         let (vcol, vtext) = f[1];
         let value = parse_number(file, line, vcol, vtext)?;
         let relevant = name.starts_with(&g)
