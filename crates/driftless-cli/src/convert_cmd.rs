@@ -1,4 +1,5 @@
-//! `driftless convert`: delimited text ↔ compact binary log.
+//! `driftless convert`: delimited text ↔ compact binary log; also PX4 ULog / ArduPilot
+//! DataFlash (one IMU instance, `--instance N`) → CSV or binary.
 
 use crate::input::InputArgs;
 use anyhow::{Context, Result};
@@ -7,7 +8,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ConvertArgs {
-    /// Input log (text or binary).
+    /// Input log (text, binary DRIFTLOG, PX4 ULog or ArduPilot DataFlash).
     pub input: PathBuf,
     /// Output: `.dlog` (binary DRIFTLOG) or `.csv`.
     pub output: PathBuf,

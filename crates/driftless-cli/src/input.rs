@@ -8,9 +8,13 @@ use driftless::io::{
 };
 use std::path::Path;
 
-/// How to read a delimited text log (ignored for binary `DRIFTLOG` files).
+/// How to read a delimited text log (ignored for binary `DRIFTLOG` files and for autopilot
+/// logs, which are recognised by their magic bytes whatever their extension).
 #[derive(Args, Debug, Clone)]
 pub struct InputArgs {
+    /// IMU instance to take from a PX4 ULog (`.ulg`) or ArduPilot DataFlash (`.bin`) log.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub instance: u8,
     /// Sample rate in Hz (required when the file has no time column).
     #[arg(long, value_name = "HZ")]
     pub rate: Option<f64>,
@@ -86,8 +90,13 @@ impl InputArgs {
         Ok(o)
     }
 
-    /// Read the log at `path`, text or binary.
+    /// Read the log at `path`: text, binary `DRIFTLOG`, or (feature `autopilot-logs`) one
+    /// IMU instance of a PX4 ULog / ArduPilot DataFlash log, chosen by the file's magic bytes.
     pub fn read(&self, path: &Path) -> Result<ImuLog> {
+        #[cfg(feature = "autopilot-logs")]
+        if let Some(log) = read_autopilot(path, self.instance)? {
+            return Ok(log);
+        }
         let opts = self.text_options()?;
         let log = read_log_file(path, &opts)?;
         if log.is_empty() {
@@ -105,4 +114,83 @@ fn parse_time_unit(s: &str) -> Result<TimeUnit> {
         "ns" => TimeUnit::Nanoseconds,
         other => anyhow::bail!("--time-unit {other:?}: expected s, ms, us or ns"),
     })
+}
+
+/// Reads one IMU instance of an autopilot log, telling on stderr what the log holds;
+/// `Ok(None)` when `path` is not an autopilot log (by its first bytes).
+#[cfg(feature = "autopilot-logs")]
+fn read_autopilot(path: &Path, instance: u8) -> Result<Option<ImuLog>> {
+    use anyhow::Context;
+    use std::io::Read;
+    let mut head = Vec::with_capacity(8);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(8).read_to_end(&mut head))
+        .with_context(|| format!("reading {}", path.display()))?;
+    if driftless::io::detect_format(&head).is_none() {
+        return Ok(None);
+    }
+    let Some(all) = driftless::io::imu_logs_from_autopilot_file(path)? else {
+        return Ok(None);
+    };
+    let imu_topics: Vec<String> = all
+        .found
+        .iter()
+        .filter(|(n, _)| {
+            n.starts_with("sensor_gyro[") || n.starts_with("sensor_accel[") || n.starts_with("IMU")
+        })
+        .map(|(n, c)| format!("{n} ×{c}"))
+        .collect();
+    eprintln!(
+        "{}: {}, {} topics/message types; IMU data: {}",
+        path.display(),
+        all.format.name(),
+        all.found.len(),
+        imu_topics.join(", ")
+    );
+    for imu in &all.imus {
+        let l = &imu.log;
+        let span = l
+            .channel("temperature")
+            .map(|t| {
+                let (lo, hi) = t
+                    .values
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                        (a.min(x), b.max(x))
+                    });
+                format!(", temperature {lo:.2}–{hi:.2} °C")
+            })
+            .unwrap_or_default();
+        eprintln!(
+            "  instance {}: {} samples, τ0 = {:.4} s, channels {}{span}{}",
+            imu.instance,
+            l.len(),
+            l.tau0_s,
+            l.channels
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join(","),
+            if imu.instance == instance {
+                "  ← used"
+            } else {
+                ""
+            }
+        );
+    }
+    if let Some(at) = all.truncated_at_byte {
+        eprintln!("  log truncated: stopped cleanly at the message cut off at byte {at}");
+    }
+    for n in &all.notes {
+        eprintln!("  note: {n}");
+    }
+    let available: Vec<String> = all.imus.iter().map(|i| i.instance.to_string()).collect();
+    let Some(pos) = all.imus.iter().position(|i| i.instance == instance) else {
+        anyhow::bail!(
+            "{}: no IMU instance {instance} (instances: {}); choose one with --instance N",
+            path.display(),
+            available.join(", ")
+        );
+    };
+    Ok(all.imus.into_iter().nth(pos).map(|i| i.log))
 }

@@ -67,7 +67,8 @@ pub struct ExportArgs {
 #[derive(Args, Debug)]
 pub struct RampArgs {
     /// Static log: time, gyro and/or accelerometer columns with units, one temperature
-    /// column (°C).
+    /// column (°C); or a PX4 ULog (`sensor_gyro`/`sensor_accel`) or ArduPilot DataFlash
+    /// (`IMU`) log, recognised by its magic bytes (pick the IMU with `--instance N`).
     pub log: PathBuf,
     /// Polynomial order, 1–5.
     #[arg(long, default_value_t = 3)]
@@ -282,6 +283,19 @@ fn ramp(r: RampArgs) -> Result<()> {
             r.log.display()
         );
     };
+    let (t_lo, t_hi) = temp
+        .values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    eprintln!(
+        "{}: {} samples over {:.1} s, temperature {t_lo:.2}–{t_hi:.2} °C (span {:.2} °C)",
+        r.log.display(),
+        log.len(),
+        time.last().copied().unwrap_or(0.0) - time.first().copied().unwrap_or(0.0),
+        t_hi - t_lo
+    );
     let chans: Vec<(&str, &[f64])> = log
         .channels
         .iter()

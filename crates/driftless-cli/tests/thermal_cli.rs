@@ -330,3 +330,82 @@ fn export_autopilot_parameters() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Shared reference data: `$DRIFTLESS_DATA`, else `../shared/data` beside the project.
+fn data(rel: &str) -> std::path::PathBuf {
+    match std::env::var_os("DRIFTLESS_DATA") {
+        Some(p) => std::path::PathBuf::from(p),
+        None => std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
+    }
+    .join(rel)
+}
+
+/// `thermal ramp` on pyulog's real PX4 ULog (`logs/px4_ulog/sample_log_small.ulg`): the
+/// log is recognised by its magic bytes, its three IMU instances are listed with their
+/// temperatures, and — 6 samples at 1 Hz spanning 0.34 °C — the ramp fails with the
+/// clear too-few-bins message rather than fitting noise. `--instance 7` names the
+/// instances that exist.
+#[test]
+#[ignore = "needs shared data"]
+fn ramp_on_a_real_px4_ulog_fails_clearly_for_lack_of_temperature_span() {
+    let log = data("logs/px4_ulog/sample_log_small.ulg");
+    let out = bin()
+        .args(["thermal", "ramp", "--instance", "2"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("PX4 ULog"), "{err}");
+    assert!(err.contains("sensor_gyro[2] ×6"), "{err}");
+    assert!(err.contains("instance 2: 6 samples"), "{err}");
+    assert!(err.contains("temperature 29.43–29.72 °C  ← used"), "{err}");
+    assert!(err.contains("span 0.29 °C"), "{err}");
+    assert!(
+        err.contains("0 temperature bins with ≥ 50 samples; an order-3 fit needs at least 5"),
+        "{err}"
+    );
+    let out = bin()
+        .args(["thermal", "ramp", "--instance", "7"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no IMU instance 7 (instances: 0, 1, 2)"),
+        "{err}"
+    );
+}
+
+/// `convert` of the truncated real DataFlash log to CSV: instance 1, 10 rows, the cut
+/// reported on stderr.
+#[test]
+#[ignore = "needs shared data"]
+fn convert_a_truncated_dataflash_log_to_csv() {
+    let dir = std::env::temp_dir().join(format!("driftless-df-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("imu1.csv");
+    let out = bin()
+        .args(["convert", "--instance", "1"])
+        .arg(data("logs/ardupilot_dataflash/backend_log_80k.bin"))
+        .arg(&csv)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("stopped cleanly at the message cut off at byte 81918"),
+        "{err}"
+    );
+    assert!(err.contains("7 channels × 10 samples"), "{err}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(rows.len(), 11);
+    assert!(
+        rows[0].starts_with("time [s],gyro_x [rad/s]"),
+        "{}",
+        rows[0]
+    );
+    assert!(rows[1].ends_with(",28.5"), "{}", rows[1]);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -153,3 +153,41 @@ fn mutated_binary_never_panics() {
     }
     assert!(errs > 2500, "{errs}");
 }
+
+/// The real PX4 ULog and truncated ArduPilot DataFlash logs (`../shared/data/logs`) with
+/// bit flips, overwritten bytes and cuts: no panic, IMU logs finite when they come out.
+#[cfg(feature = "autopilot-logs")]
+#[test]
+#[ignore = "needs shared data"]
+fn mutated_autopilot_logs_never_panic() {
+    use driftless::io::imu_logs_from_autopilot;
+    let dir = match std::env::var_os("DRIFTLESS_DATA") {
+        Some(p) => std::path::PathBuf::from(p),
+        None => std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"),
+    };
+    let ulog = std::fs::read(dir.join("logs/px4_ulog/sample_log_small.ulg")).unwrap();
+    let df = std::fs::read(dir.join("logs/ardupilot_dataflash/backend_log_80k.bin")).unwrap();
+    // The ULog is cut to its first 64 KiB (definitions, parameters and the first data) to
+    // keep 300 parses cheap; the DataFlash log is used whole.
+    let seeds = [ulog[..ulog.len().min(65_536)].to_vec(), df];
+    let mut rng = XorShift(0xD1F7_1E55_0000_0001);
+    for round in 0..600 {
+        let mut v = seeds[round % 2].clone();
+        for _ in 0..1 + rng.below(8) {
+            let i = rng.below(v.len());
+            match rng.below(3) {
+                0 => v[i] ^= 1 << rng.below(8),
+                1 => v[i] = rng.next() as u8,
+                _ => v.truncate(i.max(1)),
+            }
+        }
+        if let Ok(Some(r)) = imu_logs_from_autopilot(&v, "mut") {
+            for imu in &r.imus {
+                for c in &imu.log.channels {
+                    assert_eq!(c.values.len(), imu.log.len());
+                    assert!(c.values.iter().all(|x| x.is_finite()));
+                }
+            }
+        }
+    }
+}

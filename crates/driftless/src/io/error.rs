@@ -7,6 +7,11 @@
 //! `imu.csv:12:17: non-numeric value "abc" in column 3 (gyro_y)`. Problems that concern a
 //! whole row (time order, gaps) name the line and the time column's field number but no
 //! byte column; problems with the options or the whole input name only the input.
+//!
+//! Binary inputs have no lines: errors at one place in them (the autopilot logs of
+//! `io::ulog` and `io::dataflash`) are [`LogError::AtByte`], naming the 0-based **byte
+//! offset** of the offending message instead, `PATH@byte OFFSET: FORMAT: message` (the
+//! offset a hex dump shows).
 
 use std::fmt;
 
@@ -324,6 +329,19 @@ pub enum LogError {
         /// What is wrong.
         message: String,
     },
+    /// A binary third-party log (PX4 ULog, ArduPilot DataFlash) that is wrong at one place:
+    /// a malformed message, a value that is not acceptable (NaN sample, time going back).
+    #[error("{path}@byte {byte_offset}: {format}: {message}")]
+    AtByte {
+        /// Input display name.
+        path: String,
+        /// 0-based byte offset of the offending message.
+        byte_offset: u64,
+        /// The format's name.
+        format: &'static str,
+        /// What is wrong.
+        message: String,
+    },
     /// Writer: the log itself is inconsistent (channel lengths differ, …).
     #[error("{at}: cannot write log: {message}")]
     InvalidLog {
@@ -339,7 +357,7 @@ impl LogError {
     pub fn location(&self) -> Option<&Location> {
         use LogError::*;
         match self {
-            Io { .. } => None,
+            Io { .. } | AtByte { .. } => None,
             NonNumeric { at, .. }
             | EmptyField { at, .. }
             | NonFinite { at, .. }
@@ -363,6 +381,14 @@ impl LogError {
             | InvalidLog { at, .. }
             | InvalidValue { at, .. }
             | Malformed { at, .. } => Some(at),
+        }
+    }
+
+    /// The 0-based byte offset the error names, if any (binary inputs).
+    pub fn byte_offset(&self) -> Option<u64> {
+        match self {
+            LogError::AtByte { byte_offset, .. } => Some(*byte_offset),
+            _ => None,
         }
     }
 

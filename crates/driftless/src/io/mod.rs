@@ -4,19 +4,37 @@
 //! * [`text`]: delimited text (CSV, whitespace, tab, semicolon), streamed and parsed in parallel.
 //! * [`binary`]: the compact `DRIFTLOG` column-major binary format (reader and writer).
 //! * [`write`]: CSV writer.
+//! * [`ulog`], [`dataflash`], [`autopilot`] (feature `autopilot-logs`, on by default): PX4
+//!   ULog and ArduPilot DataFlash logs → one [`log::ImuLog`] per IMU instance.
 //! * [`units`]: unit strings → SI conversion.
 //! * [`error`]: one error type, [`LogError`], naming file, line and column.
 //!
 //! OWNER: helper "io" (text, binary, units, errors, fuzzing).
 
+#[cfg(feature = "autopilot-logs")]
+pub mod autopilot;
 pub mod binary;
+#[cfg(feature = "autopilot-logs")]
+pub mod dataflash;
 pub mod error;
 pub mod log;
 pub mod nav;
 mod number;
 pub mod text;
+#[cfg(feature = "autopilot-logs")]
+pub mod ulog;
 pub mod units;
 pub mod write;
+
+#[cfg(feature = "autopilot-logs")]
+pub use autopilot::{
+    AutopilotFormat, AutopilotImu, AutopilotImuLogs, detect_format, imu_logs_from_autopilot,
+    imu_logs_from_autopilot_file,
+};
+#[cfg(feature = "autopilot-logs")]
+pub use dataflash::{imu_logs_from_dataflash, parse_dataflash};
+#[cfg(feature = "autopilot-logs")]
+pub use ulog::{imu_logs_from_ulog, parse_ulog};
 
 pub use binary::{read_binary, read_binary_file, write_binary, write_binary_file};
 pub use error::{Location, LogError};
