@@ -651,7 +651,6 @@ fn fields(line: &str, is_sep: impl Fn(char) -> bool) -> Vec<(usize, &str)> {
     out
 }
 
-
 /// A parameter name field (column, text): letters, digits and `_` only.
 fn parameter_name<'a>(
     file: &str,
