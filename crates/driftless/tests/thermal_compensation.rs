@@ -23,7 +23,7 @@ use driftless::sim::presets::Preset;
 use driftless::sim::scenario::Scenario;
 use driftless::sim::sensor::{OutputKind, SensorModel};
 use driftless::thermal::FitOptions;
-use driftless::thermal::soak::{ChannelDrift, SoakDrift, soak_calibration};
+use driftless::thermal::soak::{SoakDrift, soak_calibration};
 use driftless_model::compensation::OutOfRange;
 
 const DRIVE: &str = r#"
@@ -108,14 +108,7 @@ fn vehicle_warm_up_residual_thermal_bias_below_five_percent() {
         .expect("model")
         .simulate(&proto.ideal(OutputKind::Rates), &curve, 31)
         .expect("simulate");
-    let ch = |n: &driftless::sim::sensor_config::AxisNoise| ChannelDrift {
-        bias_instability: n.bias_instability,
-        rate_random_walk: n.rate_random_walk,
-    };
-    let drift = SoakDrift {
-        accel: cfg.accel.noise.each_ref().map(ch),
-        gyro: cfg.gyro.noise.each_ref().map(ch),
-    };
+    let drift = SoakDrift::from_sensor_config(&cfg);
     let soak = soak_calibration(
         &proto.manifest,
         chamber.accel.each_ref().map(Vec::as_slice),

@@ -29,7 +29,7 @@ use driftless::sim::chamber_manifest::SegmentKind;
 use driftless::sim::presets::Preset;
 use driftless::sim::sensor::{OutputKind, SensorModel};
 use driftless::thermal::FitOptions;
-use driftless::thermal::soak::{ChannelDrift, SoakDrift, soak_calibration};
+use driftless::thermal::soak::{SoakDrift, soak_calibration};
 
 /// Figures of one run.
 struct Run {
@@ -162,14 +162,7 @@ fn run(seed: u64, all_terms: bool) -> Run {
     };
     let six = SixPositionOptions::from_manifest(&proto.manifest);
     // The drift model from the preset's Allan terms (what `driftless allan` reports).
-    let ch = |n: &driftless::sim::sensor_config::AxisNoise| ChannelDrift {
-        bias_instability: n.bias_instability,
-        rate_random_walk: n.rate_random_walk,
-    };
-    let drift = SoakDrift {
-        accel: cfg.accel.noise.each_ref().map(ch),
-        gyro: cfg.gyro.noise.each_ref().map(ch),
-    };
+    let drift = SoakDrift::from_sensor_config(&cfg);
     let t1 = std::time::Instant::now();
     let soak = soak_calibration(
         &proto.manifest,

@@ -111,6 +111,19 @@ pub struct SoakDrift {
 }
 
 impl SoakDrift {
+    /// The bias-instability and rate-random-walk terms of a simulated sensor's
+    /// configuration (SI), e.g. a preset's.
+    pub fn from_sensor_config(cfg: &crate::sim::sensor_config::SensorConfig) -> SoakDrift {
+        let ch = |n: &crate::sim::sensor_config::AxisNoise| ChannelDrift {
+            bias_instability: n.bias_instability,
+            rate_random_walk: n.rate_random_walk,
+        };
+        SoakDrift {
+            accel: cfg.accel.noise.each_ref().map(ch),
+            gyro: cfg.gyro.noise.each_ref().map(ch),
+        }
+    }
+
     /// The bias-instability and rate-random-walk terms of a noise-model file
     /// (`driftless allan --save-model`): its angular-rate channels are gyro x, y, z and
     /// its specific-force channels accel x, y, z, in file order (SI units, so the soak's
