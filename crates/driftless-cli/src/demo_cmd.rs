@@ -1,5 +1,7 @@
-//! `driftless demo`: simulate an 18-h, 100 Hz static six-axis IMU log with known noise
-//! terms, run the Allan analysis and noise fit on it, and compare with the truth.
+//! `driftless demo`: the seed paper's experiment on the built-in `adi-like` scenario
+//! (`driftless::experiment`, results in `./driftless-demo/`). `driftless demo --noise`:
+//! the noise-analysis demo — an 18-h, 100 Hz static six-axis IMU log with known noise
+//! terms, the Allan analysis and noise fit on it, compared with the truth.
 
 use crate::allan_cmd::{AllanOutput, analyse_log, json_output};
 use crate::output::{Table, sci};
@@ -24,16 +26,25 @@ pub struct DemoArgs {
     /// Output folder.
     #[arg(long, default_value = "driftless-demo")]
     pub out: PathBuf,
-    /// Length of the simulated static log, hours.
+    /// Monte Carlo runs of the experiment (default: the built-in scenario's 20).
+    #[arg(long)]
+    pub runs: Option<usize>,
+    /// Instead of the experiment: the noise-analysis demo (18-h static log → Allan).
+    #[arg(long)]
+    pub noise: bool,
+    /// Print the built-in scenario (a starting point for `driftless experiment`) and exit.
+    #[arg(long)]
+    pub print_scenario: bool,
+    /// (--noise) Length of the simulated static log, hours.
     #[arg(long, default_value_t = 18.0)]
     pub hours: f64,
-    /// Sample rate, Hz.
+    /// (--noise) Sample rate, Hz.
     #[arg(long, default_value_t = 100.0)]
     pub rate: f64,
-    /// Random seed (the run is reproducible from it).
+    /// (--noise) Random seed (the run is reproducible from it).
     #[arg(long, default_value_t = 2026)]
     pub seed: u64,
-    /// Also write the simulated log (binary DRIFTLOG, ~300 MB for 18 h).
+    /// (--noise) Also write the simulated log (binary DRIFTLOG, ~300 MB for 18 h).
     #[arg(long)]
     pub write_log: bool,
     /// Print the JSON document of `driftless allan --json` instead of tables.
@@ -90,6 +101,18 @@ pub fn demo_truth(rate_hz: f64, duration_s: f64) -> Vec<(String, Quantity, Stati
 }
 
 pub fn run(a: DemoArgs) -> Result<()> {
+    if a.print_scenario {
+        print!("{}", driftless::experiment::scenario::BUILTIN_ADI_LIKE);
+        return Ok(());
+    }
+    if !a.noise {
+        let sc = driftless::experiment::ExperimentScenario::builtin_adi_like()?;
+        return crate::experiment_cmd::run_scenario(sc, &a.out, a.runs, a.json);
+    }
+    noise_demo(a)
+}
+
+fn noise_demo(a: DemoArgs) -> Result<()> {
     let t_all = Instant::now();
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let duration_s = a.hours * 3600.0;

@@ -1,8 +1,10 @@
 //! `driftless` — from raw MEMS IMU logs to a navigation error budget.
 //!
 //! Subcommands: `allan` (noise analysis), `convert` (text ↔ compact binary log),
-//! `demo` (the whole issue-2 pipeline on built-in simulated data), `bench`, `nav`
-//! (GNSS/INS), `simulate` (scenario → IMU, GNSS and truth files).
+//! `experiment` (the seed paper's experiment end to end), `demo` (the experiment on
+//! built-in simulated data; `--noise`: the Allan demo), `bench`, `nav` (GNSS/INS),
+//! `simulate` (scenario → IMU, GNSS and truth files), `calibrate`, `thermal`,
+//! `compensate`.
 
 mod allan_cmd;
 mod bench_cmd;
@@ -10,6 +12,7 @@ mod calibrate_cmd;
 mod compensate_cmd;
 mod convert_cmd;
 mod demo_cmd;
+mod experiment_cmd;
 mod input;
 mod nav_cmd;
 mod output;
@@ -52,7 +55,10 @@ enum Command {
     /// Simulate IMU, GNSS and truth from a scenario file (trajectory, sensor errors,
     /// temperature, GNSS).
     Simulate(simulate_cmd::SimulateArgs),
-    /// Simulate an 18-h static six-axis IMU log with known noise, analyse it, compare.
+    /// The paper's experiment end to end: noise model, thermal model, vehicle run with
+    /// GNSS outages in three cases, Table 1, figures and an HTML report.
+    Experiment(experiment_cmd::ExperimentArgs),
+    /// The experiment on the built-in adi-like scenario (`--noise`: the Allan demo).
     Demo(demo_cmd::DemoArgs),
 }
 
@@ -64,6 +70,7 @@ fn main() -> ExitCode {
         Command::Calibrate(a) => calibrate_cmd::run(a),
         Command::Compensate(a) => compensate_cmd::run(a),
         Command::Demo(a) => demo_cmd::run(a),
+        Command::Experiment(a) => experiment_cmd::run(a),
         Command::Bench(a) => bench_cmd::run(a),
         Command::Nav(a) => nav_cmd::run(a),
         Command::Simulate(a) => simulate_cmd::run(a),

@@ -12,6 +12,7 @@
 pub mod allan;
 pub mod calib;
 pub mod eval;
+pub mod experiment;
 pub mod io;
 pub mod nav;
 pub mod report;

@@ -1,0 +1,208 @@
+//! `driftless experiment SCENARIO.toml`: the seed paper's experiment end to end
+//! (`driftless::experiment`) — Allan → noise model, chamber → thermal model, the vehicle
+//! run in cases (a) raw, (b) room calibration, (c) room + thermal, forward and smoothed,
+//! GNSS outages, Table 1, figures and one self-contained HTML report. `driftless demo`
+//! runs it on the built-in `adi-like` scenario.
+
+use anyhow::{Context, Result};
+use clap::Args;
+use driftless::experiment::monte_carlo::{ExperimentResult, run_experiment};
+use driftless::experiment::run::Prepared;
+use driftless::experiment::table::{
+    Column, ExperimentDocument, csv, markdown, ratio_explanation, table_rows,
+};
+use driftless::experiment::{ExperimentScenario, prepare};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+#[derive(Args, Debug)]
+pub struct ExperimentArgs {
+    /// Experiment scenario (TOML; see `driftless::experiment::scenario` or the README).
+    pub scenario: PathBuf,
+    /// Output folder.
+    #[arg(long, default_value = "driftless-experiment")]
+    pub out: PathBuf,
+    /// Monte Carlo runs (default: the scenario's `[monte_carlo] runs`).
+    #[arg(long)]
+    pub runs: Option<usize>,
+    /// Print the JSON document instead of tables.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs a loaded scenario and writes every output into `out`.
+pub fn run_scenario(
+    scenario: ExperimentScenario,
+    out: &Path,
+    runs: Option<usize>,
+    json: bool,
+) -> Result<()> {
+    let t_all = Instant::now();
+    let show = !json;
+    let sp = crate::demo_cmd::spinner(
+        show,
+        "checking the scenario and choosing the outage windows".into(),
+    );
+    let p = prepare(scenario)?;
+    sp.finish_and_clear();
+    let k = runs.unwrap_or(p.scenario.monte_carlo.runs);
+    if show {
+        println!(
+            "{} — {} outage(s) of {}; {} run(s)",
+            p.scenario.title.as_deref().unwrap_or(&p.scenario.name),
+            p.outages.len(),
+            p.outages.first().map_or("–".into(), |o| format!(
+                "{:.0} s",
+                o.window.end_s - o.window.start_s
+            )),
+            k
+        );
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+
+    let noise_bar = crate::demo_cmd::spinner(
+        show,
+        "noise stage: static log → Allan deviation → noise model".into(),
+    );
+    let runs_bar = if show {
+        let b = ProgressBar::new(k as u64);
+        b.set_style(
+            ProgressStyle::with_template(
+                "{spinner} chamber + vehicle runs {pos}/{len} [{bar:30}] {elapsed} (eta {eta})",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        b.enable_steady_tick(Duration::from_millis(150));
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    runs_bar.set_position(0);
+    let progress = |stage: &str, done: u64, _total: u64| match stage {
+        "noise" if done >= 1 => noise_bar.finish_and_clear(),
+        "runs" => runs_bar.set_position(done),
+        _ => {}
+    };
+    let result = run_experiment(&p, runs, &progress)?;
+    runs_bar.finish_and_clear();
+    let written = write_outputs(out, &p, &result)?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&ExperimentDocument::new(&p, &result))?
+        );
+        return Ok(());
+    }
+    print_human(&p, &result);
+    println!(
+        "\nwrote {} files to {} in {:.1} s",
+        written.len(),
+        out.display(),
+        t_all.elapsed().as_secs_f64()
+    );
+    for w in &written {
+        println!("  {}", w.display());
+    }
+    Ok(())
+}
+
+pub fn run(a: ExperimentArgs) -> Result<()> {
+    let sc = ExperimentScenario::from_file(&a.scenario)?;
+    run_scenario(sc, &a.out, a.runs, a.json)
+}
+
+fn print_human(p: &Prepared, r: &ExperimentResult) {
+    println!();
+    for col in [Column::ForwardEnd, Column::SmoothedMax] {
+        let (h, rows) = table_rows(p, &r.detailed, col);
+        println!("Table 1 (run 0): {}", col.title());
+        let mut t = crate::output::Table::new(h);
+        for row in rows {
+            t.row(row);
+        }
+        print!("{}", t.render());
+        println!();
+    }
+    let s = &r.summary;
+    println!(
+        "Monte Carlo over {} run(s): mean end-of-outage horizontal error per run, forward filter [m]",
+        s.runs
+    );
+    let mut t = crate::output::Table::new(["case", "mean", "p5", "median", "p95", "failed runs"]);
+    for c in &s.cases {
+        let f = |v: f64| driftless::experiment::table::fmt_m(v);
+        match &c.forward_mean_end_m {
+            Some(sp) => t.row(vec![
+                c.label.clone(),
+                f(sp.mean),
+                f(sp.p5),
+                f(sp.p50),
+                f(sp.p95),
+                c.failed_runs.to_string(),
+            ]),
+            None => t.row(vec![
+                c.label.clone(),
+                "–".into(),
+                "–".into(),
+                "–".into(),
+                "–".into(),
+                c.failed_runs.to_string(),
+            ]),
+        }
+    }
+    print!("{}", t.render());
+    for c in &s.cases {
+        if let Some(m) = &c.first_failure {
+            println!(
+                "{}: failed in {} run(s), first: {m}",
+                c.label, c.failed_runs
+            );
+        }
+    }
+    println!();
+    for line in ratio_explanation(p, r) {
+        println!("{line}");
+    }
+}
+
+/// Writes Table 1 (Markdown, CSV), the JSON document and the report; returns the paths.
+pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    let mut md = String::new();
+    md.push_str(&format!(
+        "# {}\n\n",
+        p.scenario.title.as_deref().unwrap_or(&p.scenario.name)
+    ));
+    for (col, file) in [
+        (Column::ForwardEnd, "table1.csv"),
+        (Column::ForwardMax, "table1-max.csv"),
+        (Column::SmoothedMax, "table1-smoothed.csv"),
+    ] {
+        let (h, rows) = table_rows(p, &r.detailed, col);
+        md.push_str(&format!("## Table 1 (run 0): {}\n\n", col.title()));
+        md.push_str(&markdown(&h, &rows));
+        md.push('\n');
+        let path = out.join(file);
+        std::fs::write(&path, csv(&h, &rows))
+            .with_context(|| format!("writing {}", path.display()))?;
+        written.push(path);
+    }
+    md.push_str("## Monte Carlo and the paper's ratio\n\n");
+    for line in ratio_explanation(p, r) {
+        md.push_str(&line);
+        md.push_str("\n\n");
+    }
+    let path = out.join("table1.md");
+    std::fs::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
+    written.push(path);
+    let path = out.join("experiment.json");
+    std::fs::write(
+        &path,
+        serde_json::to_string_pretty(&ExperimentDocument::new(p, r))?,
+    )
+    .with_context(|| format!("writing {}", path.display()))?;
+    written.push(path);
+    Ok(written)
+}

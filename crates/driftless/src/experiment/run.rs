@@ -1,0 +1,801 @@
+//! The experiment's stages: [`prepare`] (checks and outage windows, fast), then
+//! [`noise_stage`] → [`thermal_stage`] → [`vehicle_run`] (module docs of
+//! [`super`]).
+//!
+//! Seeds: run k of a Monte Carlo draws its chamber log, vehicle IMU and GNSS from
+//! `splitmix64(seed ⊕ tag ⊕ k)`; the static log of the noise stage is drawn once. The
+//! sensor's *design* (deterministic thermal curves, misalignment …) is the same in every
+//! stage and run; what changes is what a new power-up changes (turn-on biases) and noise.
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::ExperimentError;
+use super::scenario::{ExperimentScenario, VehicleSource};
+use crate::allan::analysis::{AnalysisConfig, ChannelResult, analyse_channels};
+use crate::allan::fit::FitConfig;
+use crate::allan::noise_model::NoiseModel;
+use crate::allan::taus::TauSpec;
+use crate::calib::six_position::SixPositionOptions;
+use crate::eval::metrics::{MetricOptions, OutageReport, outage_errors};
+use crate::eval::reference::{from_nav_states, reference_from_fixes};
+use crate::eval::select::{SelectOptions, SelectedOutage, resolve_outages};
+use crate::io::nav::{GnssFixes, GnssReadOptions, NavSolution};
+use crate::io::{ImuLog, Quantity};
+use crate::nav::filter::aids::NhcConfig;
+use crate::nav::filter::model::{FilterConfig, GaussMarkov, ImuNoise};
+use crate::nav::filter::run::{InitialState, run_forward};
+use crate::nav::filter::smoother::smooth;
+use crate::nav::outage::{OutageSpec, OutageWindow};
+use crate::nav::pipeline::{
+    GnssOutsideImu, ImuStream, ImuStreamOptions, TaggedCsvOptions, imu_from_kfgins,
+    imu_from_tagged_csv_files, read_gnss_file, select_gnss,
+};
+use crate::nav::session::{SessionConfig, initialise_in_motion, prime_gyro_bias};
+use crate::sim::scenario::{ErrorTerms, ImuSpec, OutputSpec, Scenario, TrajectorySpec};
+use crate::sim::sensor_config::SensorConfig;
+use crate::sim::sensor_data::{OutputKind, SensorOutput};
+use crate::thermal::soak::{SoakCalibration, SoakDrift, soak_calibration};
+use crate::thermal::{FitOptions, model_file::ThermalModelFile};
+use driftless_model::compensation::{CompensationModel, OutOfRange};
+use driftless_model::units::DEG;
+
+/// The three ways the vehicle IMU data are processed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Case {
+    /// (a) the IMU output as logged.
+    Raw,
+    /// (b) room-temperature calibration only (bias, scale, misalignment at 25 °C) — the
+    /// paper's "uncompensated"; on recorded data without a calibration, the gyro biases
+    /// of the static start removed.
+    Room,
+    /// (c) room calibration + thermal model at the sensor's temperature reading.
+    Thermal,
+}
+
+impl Case {
+    /// Short label for tables and legends.
+    pub fn label(self) -> &'static str {
+        match self {
+            Case::Raw => "(a) raw",
+            Case::Room => "(b) room cal",
+            Case::Thermal => "(c) room + thermal",
+        }
+    }
+}
+
+/// Progress callback: (stage, done, total).
+pub type Progress<'a> = &'a (dyn Fn(&str, u64, u64) + Sync);
+
+/// Recorded vehicle data, read in [`prepare`].
+#[derive(Debug)]
+pub struct RecordedVehicle {
+    /// The IMU stream (vehicle frame).
+    pub imu: ImuStream,
+    /// GNSS fixes inside the IMU span.
+    pub fixes: GnssFixes,
+    /// Session settings (filter, aids, floors) of the data set.
+    pub session: SessionConfig,
+}
+
+/// The checked experiment, ready to run.
+#[derive(Debug)]
+pub struct Prepared {
+    /// The scenario.
+    pub scenario: ExperimentScenario,
+    /// Where the vehicle data come from.
+    pub source: VehicleSource,
+    /// The simulated sensor (simulated stages).
+    pub sensor: Option<SensorConfig>,
+    /// The outage windows, with the dynamics each covers.
+    pub outages: Vec<SelectedOutage>,
+    /// Vehicle data span (reference), s.
+    pub span_s: (f64, f64),
+    /// Recorded vehicle data.
+    pub recorded: Option<RecordedVehicle>,
+}
+
+impl Prepared {
+    /// The outage windows.
+    pub fn windows(&self) -> Vec<OutageWindow> {
+        self.outages.iter().map(|o| o.window).collect()
+    }
+}
+
+/// 64-bit mix (Steele et al., SplitMix64) for per-run seeds.
+pub fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Seed of stage `tag` in Monte Carlo run `run`.
+pub fn run_seed(seed: u64, tag: u64, run: usize) -> u64 {
+    splitmix64(seed ^ tag.wrapping_mul(0x1000_0000_01B3) ^ (run as u64).wrapping_mul(0x9E37))
+}
+
+const TAG_NOISE: u64 = 1;
+const TAG_CHAMBER: u64 = 2;
+const TAG_VEHICLE: u64 = 3;
+
+fn sim_scenario(
+    sc: &ExperimentScenario,
+    sensor: &SensorConfig,
+    rate_hz: f64,
+    trajectory: TrajectorySpec,
+    seed: u64,
+    errors: ErrorTerms,
+) -> Scenario {
+    Scenario {
+        seed,
+        start_time_s: 0.0,
+        gps_week: None,
+        imu: ImuSpec {
+            rate_hz,
+            preset: None,
+            sensor: Some(sensor.clone()),
+            noise_model: None,
+            errors,
+            output: OutputKind::Rates,
+        },
+        trajectory,
+        temperature: None,
+        gnss: None,
+        output: OutputSpec::default(),
+        base_dir: sc.base_dir.clone(),
+        name: sc.name.clone(),
+    }
+}
+
+/// Checks everything that can be checked cheaply and fixes the outage windows: on a
+/// 1-Hz truth of a simulated run (no sensor simulated), or on the GNSS fixes of a
+/// recorded one (read here, with the IMU file). An impossible outage request fails here,
+/// before any long computation.
+pub fn prepare(scenario: ExperimentScenario) -> Result<Prepared, ExperimentError> {
+    scenario.check()?;
+    let source = scenario.vehicle_source()?;
+    let sensor = scenario.sensor_config()?;
+    let spec = scenario.outage_spec()?;
+    let opts = SelectOptions {
+        min_gap_s: scenario.outages.min_gap_s,
+        converge_s: scenario.outages.converge_s,
+        ..SelectOptions::default()
+    };
+    let outage_err = |e: crate::eval::EvalError| scenario.invalid(format!("[outages] {e}"));
+    // Outages start no earlier than `converge_s` after the filter can start.
+    let opts_for = |r: &NavSolution| {
+        let t0 = r.time_s.first().copied().unwrap_or(0.0);
+        let moving = r
+            .time_s
+            .iter()
+            .zip(&r.vel_ned_m_s)
+            .find(|(_, v)| v[0].hypot(v[1]) >= 3.0)
+            .map_or(t0, |(t, _)| *t);
+        SelectOptions {
+            converge_s: moving - t0 + scenario.outages.converge_s,
+            ..opts
+        }
+    };
+    match source {
+        VehicleSource::Simulated => {
+            let (Some(s), Some(traj)) = (&sensor, &scenario.vehicle.trajectory) else {
+                return Err(scenario.invalid("a simulated [vehicle] needs [sensor]"));
+            };
+            let mut sim = sim_scenario(&scenario, s, 10.0, traj.clone(), 1, ErrorTerms::None);
+            sim.output.truth_rate_hz = Some(1.0);
+            let truth = sim
+                .run()
+                .map_err(|e| scenario.invalid(format!("[vehicle]: {e}")))?
+                .truth;
+            let span = span(&truth.time_s);
+            let outages = resolve_outages(&spec, &truth, &opts_for(&truth)).map_err(outage_err)?;
+            Ok(Prepared {
+                scenario,
+                source,
+                sensor,
+                outages,
+                span_s: span,
+                recorded: None,
+            })
+        }
+        VehicleSource::Drive0708 | VehicleSource::KfGins => {
+            let v = &scenario.vehicle;
+            let (Some(imu_rel), Some(gnss_rel)) = (&v.imu_file, &v.gnss_file) else {
+                return Err(scenario.invalid("recorded [vehicle] needs imu_file and gnss_file"));
+            };
+            let (imu_path, gnss_path) = (scenario.resolve(imu_rel), scenario.resolve(gnss_rel));
+            let stage = |e: &dyn std::fmt::Display| ExperimentError::stage("vehicle", e);
+            let (imu, mut session) = if source == VehicleSource::Drive0708 {
+                let mut tag = imu_path.clone().into_os_string();
+                tag.push(".tag");
+                let imu = imu_from_tagged_csv_files(
+                    &imu_path,
+                    std::path::Path::new(&tag),
+                    &TaggedCsvOptions::drive_0708(),
+                )
+                .map_err(|e| stage(&e))?;
+                (imu, SessionConfig::drive_0708())
+            } else {
+                let inc = crate::io::nav::read_kfgins_imu_file(&imu_path).map_err(|e| stage(&e))?;
+                let imu = imu_from_kfgins(
+                    &inc,
+                    &imu_path.display().to_string(),
+                    &ImuStreamOptions::default(),
+                )
+                .map_err(|e| stage(&e))?;
+                let noise = crate::nav::session::consumer_mems_noise();
+                (imu, SessionConfig::new(FilterConfig::new(noise, [0.0; 3])))
+            };
+            if let Some(l) = v.lever_arm_b_m {
+                session.filter.lever_arm_b_m = l;
+            }
+            session.smooth = false;
+            let gnss =
+                read_gnss_file(&gnss_path, &GnssReadOptions::default()).map_err(|e| stage(&e))?;
+            let fixes = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)
+                .map_err(|e| stage(&e))?
+                .fixes;
+            let reference = reference_from_fixes(&fixes).map_err(|e| stage(&e))?;
+            let outages =
+                resolve_outages(&spec, &reference, &opts_for(&reference)).map_err(outage_err)?;
+            Ok(Prepared {
+                span_s: span(&reference.time_s),
+                scenario,
+                source,
+                sensor,
+                outages,
+                recorded: Some(RecordedVehicle {
+                    imu,
+                    fixes,
+                    session,
+                }),
+            })
+        }
+    }
+}
+
+fn span(t: &[f64]) -> (f64, f64) {
+    (
+        t.first().copied().unwrap_or(0.0),
+        t.last().copied().unwrap_or(0.0),
+    )
+}
+
+/// Allan curves of the noise stage (for the report's figure).
+#[derive(Clone, Debug)]
+pub struct AllanCurves {
+    /// OADEV per channel.
+    pub results: Vec<ChannelResult>,
+    /// Channel quantities.
+    pub quantities: Vec<Quantity>,
+    /// Channel SI units.
+    pub units: Vec<String>,
+}
+
+/// Result of the noise stage.
+#[derive(Clone, Debug)]
+pub struct NoiseStage {
+    /// The noise model (fitted or read).
+    pub model: NoiseModel,
+    /// The curves, when a log was analysed.
+    pub curves: Option<AllanCurves>,
+    /// Where it came from.
+    pub source: String,
+}
+
+/// Analyses a static log: OADEV on 100 log-spaced τ, the noise terms fitted (Q, N, B, K,
+/// R), 68.3 % intervals.
+pub fn analyse_static_log(log: &ImuLog) -> Result<NoiseStage, ExperimentError> {
+    let keep: Vec<usize> = (0..log.channels.len())
+        .filter(|&i| {
+            matches!(
+                log.channels[i].quantity,
+                Quantity::AngularRate | Quantity::SpecificForce
+            )
+        })
+        .collect();
+    let n_g = keep
+        .iter()
+        .filter(|&&i| log.channels[i].quantity == Quantity::AngularRate)
+        .count();
+    if n_g != 3 || keep.len() != 6 {
+        return Err(ExperimentError::stage(
+            "noise",
+            format!(
+                "{}: the static log needs three angular-rate and three specific-force \
+                 channels in SI units; found {} and {}",
+                log.source,
+                n_g,
+                keep.len() - n_g
+            ),
+        ));
+    }
+    let inputs: Vec<(&str, Vec<&[f64]>)> = keep
+        .iter()
+        .map(|&i| {
+            let c = &log.channels[i];
+            let segs: Vec<&[f64]> = if log.segments.is_empty() {
+                vec![c.values.as_slice()]
+            } else {
+                log.segments.iter().map(|r| &c.values[r.clone()]).collect()
+            };
+            (c.name.as_str(), segs)
+        })
+        .collect();
+    let cfg = AnalysisConfig {
+        taus: TauSpec::Log(100),
+        ..AnalysisConfig::default()
+    };
+    let results = analyse_channels(&inputs, log.tau0_s, &cfg)
+        .map_err(|e| ExperimentError::stage("noise", e))?;
+    let quantities: Vec<Quantity> = keep.iter().map(|&i| log.channels[i].quantity).collect();
+    let model = NoiseModel::from_curves(
+        &log.source,
+        &results,
+        &quantities,
+        &FitConfig::default(),
+        cfg.confidence,
+    )
+    .map_err(|e| ExperimentError::stage("noise", e))?;
+    Ok(NoiseStage {
+        model,
+        curves: Some(AllanCurves {
+            units: quantities.iter().map(|q| q.si_unit().to_string()).collect(),
+            results,
+            quantities,
+        }),
+        source: log.source.clone(),
+    })
+}
+
+/// The noise stage: simulate a static log of the sensor and analyse it, analyse a given
+/// log, or read a saved model. `None` for a recorded scenario without `[noise]` (the
+/// data set's own noise settings are used).
+pub fn noise_stage(p: &Prepared) -> Result<Option<NoiseStage>, ExperimentError> {
+    let sc = &p.scenario;
+    let Some(n) = &sc.noise else {
+        return Ok(None);
+    };
+    if let Some(h) = n.hours {
+        let (Some(sensor), Some(spec)) = (&p.sensor, &sc.sensor) else {
+            return Err(sc.invalid("[noise] hours needs [sensor]"));
+        };
+        let traj = TrajectorySpec::Static {
+            lat_deg: 51.08,
+            lon_deg: -114.13,
+            height_m: 1100.0,
+            roll_deg: 0.0,
+            pitch_deg: 0.0,
+            yaw_deg: 0.0,
+            duration_s: h * 3600.0,
+        };
+        let sim = sim_scenario(
+            sc,
+            sensor,
+            spec.rate_hz,
+            traj,
+            run_seed(sc.seed, TAG_NOISE, 0),
+            ErrorTerms::All,
+        )
+        .run()
+        .map_err(|e| ExperimentError::stage("noise", e))?;
+        let log = sim.rates_log(&format!("simulated {h} h static log"));
+        return analyse_static_log(&log).map(Some);
+    }
+    if let Some(f) = &n.file {
+        let path = sc.resolve(f);
+        let log = crate::io::read_log_file(&path, &crate::io::TextOptions::default())
+            .map_err(|e| ExperimentError::stage("noise", e))?;
+        return analyse_static_log(&log).map(Some);
+    }
+    if let Some(m) = &n.model {
+        let path = sc.resolve(m);
+        let model = NoiseModel::load(&path).map_err(|e| ExperimentError::stage("noise", e))?;
+        return Ok(Some(NoiseStage {
+            model,
+            curves: None,
+            source: path.display().to_string(),
+        }));
+    }
+    Ok(None)
+}
+
+/// Result of the thermal stage.
+#[derive(Clone, Debug)]
+pub struct ThermalStage {
+    /// Room calibration + thermal deltas.
+    pub model: CompensationModel,
+    /// The soak calibration (simulated chamber), for the figures.
+    pub soak: Option<SoakCalibration>,
+}
+
+/// The chamber stage of Monte Carlo run `run`: simulate the chamber protocol with the
+/// sensor and calibrate it by the soak method (GLS with the drift implied by the noise
+/// model), or read a thermal model file. `None` without `[chamber]`.
+pub fn thermal_stage(
+    p: &Prepared,
+    noise: Option<&NoiseStage>,
+    run: usize,
+) -> Result<Option<ThermalStage>, ExperimentError> {
+    let sc = &p.scenario;
+    let Some(c) = &sc.chamber else {
+        return Ok(None);
+    };
+    let err = |e: &dyn std::fmt::Display| ExperimentError::stage("chamber", e);
+    if let Some(m) = &c.model {
+        let (_, model) = ThermalModelFile::load(sc.resolve(m)).map_err(|e| err(&e))?;
+        return Ok(Some(ThermalStage { model, soak: None }));
+    }
+    let (Some(protocol), Some(sensor), Some(spec)) = (&c.protocol, &p.sensor, &sc.sensor) else {
+        return Ok(None);
+    };
+    let mut protocol = protocol.clone();
+    protocol.sample_rate_hz = spec.rate_hz;
+    let sim = sim_scenario(
+        sc,
+        sensor,
+        spec.rate_hz,
+        TrajectorySpec::Chamber(protocol),
+        run_seed(sc.seed, TAG_CHAMBER, run),
+        ErrorTerms::All,
+    )
+    .run()
+    .map_err(|e| err(&e))?;
+    let Some(manifest) = &sim.manifest else {
+        return Err(err(&"the chamber simulation gave no segment manifest"));
+    };
+    let drift = match noise {
+        Some(n) => Some(SoakDrift::from_noise_model(&n.model).map_err(|e| err(&e))?),
+        None => None,
+    };
+    let soak = soak_calibration(
+        manifest,
+        sim.imu.accel.each_ref().map(Vec::as_slice),
+        sim.imu.gyro.each_ref().map(Vec::as_slice),
+        1.0,
+        &SixPositionOptions::from_manifest(manifest),
+        &FitOptions {
+            order: c.order,
+            ..FitOptions::default()
+        },
+        drift.as_ref(),
+    )
+    .map_err(|e| err(&e))?;
+    let model = soak
+        .compensation_model(run_seed(sc.seed, TAG_CHAMBER, run), OutOfRange::Clamp)
+        .map_err(|e| err(&e))?;
+    Ok(Some(ThermalStage {
+        model,
+        soak: Some(soak),
+    }))
+}
+
+/// One case of one vehicle run.
+#[derive(Clone, Debug)]
+pub struct CaseRun {
+    /// Which case.
+    pub case: Case,
+    /// Forward (real-time) errors, or why the filter failed.
+    pub forward: Result<OutageReport, String>,
+    /// Smoothed errors (when smoothing is on).
+    pub smoothed: Option<Result<OutageReport, String>>,
+    /// GNSS fixes accepted by the filter.
+    pub gnss_accepted: usize,
+    /// GNSS fixes rejected by the χ² gate.
+    pub gnss_rejected: usize,
+    /// The forward solution (kept for the detailed run only).
+    pub forward_solution: Option<NavSolution>,
+}
+
+impl CaseRun {
+    /// Mean end-of-outage horizontal error of the forward filter, m (`None` if it failed).
+    pub fn forward_mean_end_m(&self) -> Option<f64> {
+        mean_end(&self.forward)
+    }
+
+    /// Mean end-of-outage horizontal error of the smoothed solution, m.
+    pub fn smoothed_mean_end_m(&self) -> Option<f64> {
+        self.smoothed.as_ref().and_then(mean_end)
+    }
+}
+
+fn mean_end(r: &Result<OutageReport, String>) -> Option<f64> {
+    r.as_ref()
+        .ok()
+        .and_then(|o| o.summary.end_horizontal_m)
+        .map(|s| s.mean)
+}
+
+/// One vehicle run in every case.
+#[derive(Clone, Debug)]
+pub struct VehicleRun {
+    /// Monte Carlo index.
+    pub run: usize,
+    /// Cases in order (a), (b), (c) when available.
+    pub cases: Vec<CaseRun>,
+    /// The reference (kept for the detailed run only).
+    pub reference: Option<NavSolution>,
+    /// The GNSS fixes (kept for the detailed run only).
+    pub fixes: Option<GnssFixes>,
+    /// Sensor temperature over the run, first and last reading, °C (simulated runs).
+    pub temperature_c: Option<(f64, f64)>,
+}
+
+impl VehicleRun {
+    /// The case `c`, if it was processed.
+    pub fn case(&self, c: Case) -> Option<&CaseRun> {
+        self.cases.iter().find(|r| r.case == c)
+    }
+}
+
+fn imu_stream(out: &SensorOutput, source: &str) -> ImuStream {
+    ImuStream {
+        source: source.to_string(),
+        gps_week: None,
+        nominal_dt_s: out.dt_s,
+        epochs: out.to_increments(),
+        gaps: Vec::new(),
+    }
+}
+
+/// Applies a case's compensation to a copy of simulated rates.
+fn compensate(
+    raw: &SensorOutput,
+    case: Case,
+    thermal: Option<&ThermalStage>,
+) -> Result<SensorOutput, String> {
+    let mut out = raw.clone();
+    let Some(t) = thermal else {
+        return Ok(out);
+    };
+    let room = *t.model.calibration();
+    for k in 0..out.len() {
+        let (g, a) = (raw.gyro_at(k), raw.accel_at(k));
+        let (gc, ac) = match case {
+            Case::Raw => return Ok(out),
+            Case::Room => (room.gyro.apply(g), room.accel.apply(a)),
+            Case::Thermal => t
+                .model
+                .compensate(g, a, raw.temperature_c[k])
+                .map_err(|e| format!("sample {k}: {e}"))?,
+        };
+        for j in 0..3 {
+            out.gyro[j][k] = gc[j];
+            out.accel[j][k] = ac[j];
+        }
+    }
+    Ok(out)
+}
+
+/// Filter noise: the noise model's terms (bias as Gauss–Markov with the scenario's τ,
+/// [`ImuNoise::from_noise_model`]) and scale-factor states of σ `scale_sigma`.
+pub fn filter_noise(
+    sc: &ExperimentScenario,
+    model: &NoiseModel,
+) -> Result<ImuNoise, ExperimentError> {
+    let gm = GaussMarkov {
+        sigma: sc.filter.scale_sigma,
+        tau_s: sc.filter.bias_tau_s,
+    };
+    ImuNoise::from_noise_model(model, sc.filter.bias_tau_s, gm, gm)
+        .map_err(|e| ExperimentError::stage("filter", e))
+}
+
+struct CaseInput<'a> {
+    case: Case,
+    imu: ImuStream,
+    fixes: &'a GnssFixes,
+    session: SessionConfig,
+    prime: bool,
+}
+
+fn run_case(
+    input: CaseInput<'_>,
+    sc: &ExperimentScenario,
+    windows: &[OutageWindow],
+    reference: &NavSolution,
+    keep_solution: bool,
+) -> CaseRun {
+    let mut session = input.session;
+    session.outages = windows.to_vec();
+    let mut fcfg = session.filter.clone();
+    fcfg.outages_s = windows.iter().map(|w| (w.start_s, w.end_s)).collect();
+    let failed = |case, msg: String| CaseRun {
+        case,
+        forward: Err(msg),
+        smoothed: None,
+        gnss_accepted: 0,
+        gnss_rejected: 0,
+        forward_solution: None,
+    };
+    let primed = if input.prime {
+        prime_gyro_bias(&input.imu, session.static_prime_s.max(1.0))
+    } else {
+        None
+    };
+    let mut init: InitialState =
+        match initialise_in_motion(&input.imu, input.fixes, &session, primed) {
+            Ok(i) => i,
+            Err(e) => return failed(input.case, format!("initialisation: {e}")),
+        };
+    let f = &sc.filter;
+    if f.initial_gyro_bias_sigma_deg_s.is_some() || f.initial_accel_bias_sigma_m_s2.is_some() {
+        let n = &fcfg.imu;
+        let mut s = [0.0; 12];
+        for k in 0..3 {
+            s[k] = f
+                .initial_gyro_bias_sigma_deg_s
+                .map_or(n.gyro_bias.sigma, |v| (v * DEG).max(n.gyro_bias.sigma));
+            s[3 + k] = f
+                .initial_accel_bias_sigma_m_s2
+                .map_or(n.accel_bias.sigma, |v| v.max(n.accel_bias.sigma));
+            s[6 + k] = n.gyro_scale.sigma;
+            s[9 + k] = n.accel_scale.sigma;
+        }
+        init.sigma_sensors = Some(s);
+    }
+    let run = match run_forward(&input.imu.epochs, input.fixes, init, &fcfg) {
+        Ok(r) => r,
+        Err(e) => return failed(input.case, format!("forward filter: {e}")),
+    };
+    let opts = MetricOptions {
+        growth_step_s: 1.0,
+        ..MetricOptions::default()
+    };
+    let forward_solution = from_nav_states(run.epochs.iter().map(|e| &e.nav));
+    let forward = outage_errors(reference, &forward_solution, windows, &opts)
+        .map_err(|e| format!("forward solution: {e}"));
+    let smoothed = session.smooth.then(|| {
+        let sm = smooth(&run, &init, &fcfg).map_err(|e| format!("smoother: {e}"))?;
+        let sol = from_nav_states(sm.epochs.iter().map(|e| &e.nav));
+        outage_errors(reference, &sol, windows, &opts)
+            .map_err(|e| format!("smoothed solution: {e}"))
+    });
+    CaseRun {
+        case: input.case,
+        forward,
+        smoothed,
+        gnss_accepted: run.gnss_accepted,
+        gnss_rejected: run.gnss_rejected,
+        forward_solution: keep_solution.then_some(forward_solution),
+    }
+}
+
+/// The session (filter, aids, initialisation) of a simulated run.
+fn simulated_session(
+    sc: &ExperimentScenario,
+    noise: &NoiseStage,
+    lever_arm_b_m: [f64; 3],
+) -> Result<SessionConfig, ExperimentError> {
+    let mut f = FilterConfig::new(filter_noise(sc, &noise.model)?, lever_arm_b_m);
+    if sc.filter.nhc {
+        f.nhc = Some(NhcConfig::default());
+    }
+    let mut s = SessionConfig::new(f);
+    s.static_prime_s = 10.0;
+    Ok(s)
+}
+
+/// Vehicle run `run` in every case. `detail` keeps the reference and solutions for the
+/// figures (and smooths; other runs smooth only with `monte_carlo.smooth_all_runs`). Errors are stage failures (simulation, reading); a filter that diverges in
+/// one case is recorded in that case, not raised.
+pub fn vehicle_run(
+    p: &Prepared,
+    noise: Option<&NoiseStage>,
+    thermal: Option<&ThermalStage>,
+    run: usize,
+    detail: bool,
+) -> Result<VehicleRun, ExperimentError> {
+    let sc = &p.scenario;
+    let smooth_this = sc.filter.smooth && (detail || sc.monte_carlo.smooth_all_runs);
+    let windows = p.windows();
+    match (&p.recorded, p.source) {
+        (None, VehicleSource::Simulated) => {
+            let (Some(sensor), Some(spec), Some(traj), Some(noise)) =
+                (&p.sensor, &sc.sensor, &sc.vehicle.trajectory, noise)
+            else {
+                return Err(sc.invalid("a simulated [vehicle] needs [sensor] and [noise]"));
+            };
+            let mut scen = sim_scenario(
+                sc,
+                sensor,
+                spec.rate_hz,
+                traj.clone(),
+                run_seed(sc.seed, TAG_VEHICLE, run),
+                ErrorTerms::All,
+            );
+            scen.temperature = sc.vehicle.temperature.clone();
+            scen.gnss = sc.vehicle.gnss.clone();
+            let sim = scen
+                .run()
+                .map_err(|e| ExperimentError::stage("vehicle", e))?;
+            let Some(fixes) = &sim.gnss else {
+                return Err(ExperimentError::stage("vehicle", "no GNSS fixes simulated"));
+            };
+            let mut session = simulated_session(sc, noise, sim.lever_arm_b_m)?;
+            session.smooth = smooth_this;
+            let mut cases = vec![Case::Raw, Case::Room];
+            if thermal.is_some() {
+                cases.push(Case::Thermal);
+            }
+            let results: Vec<CaseRun> = cases
+                .par_iter()
+                .map(|&case| {
+                    let out = match compensate(&sim.imu, case, thermal) {
+                        Ok(o) => o,
+                        Err(e) => {
+                            return CaseRun {
+                                case,
+                                forward: Err(format!("compensation: {e}")),
+                                smoothed: None,
+                                gnss_accepted: 0,
+                                gnss_rejected: 0,
+                                forward_solution: None,
+                            };
+                        }
+                    };
+                    let input = CaseInput {
+                        case,
+                        imu: imu_stream(&out, case.label()),
+                        fixes,
+                        session: session.clone(),
+                        // Without a room calibration, (b) removes the static-start gyro bias.
+                        prime: case == Case::Room && thermal.is_none(),
+                    };
+                    run_case(input, sc, &windows, &sim.truth, detail)
+                })
+                .collect();
+            let t = &sim.imu.temperature_c;
+            Ok(VehicleRun {
+                run,
+                cases: results,
+                temperature_c: t.first().zip(t.last()).map(|(a, b)| (*a, *b)),
+                reference: detail.then(|| sim.truth.clone()),
+                fixes: detail.then(|| fixes.clone()),
+            })
+        }
+        (Some(rec), _) => {
+            let mut session = rec.session.clone();
+            if let Some(n) = noise {
+                session.filter.imu = filter_noise(sc, &n.model)?;
+            }
+            session.smooth = smooth_this;
+            // Reference: case (b)'s smoothed solution with every fix.
+            let reference = {
+                let mut s = session.clone();
+                s.outages.clear();
+                let primed = prime_gyro_bias(&rec.imu, s.static_prime_s.max(1.0));
+                let init = initialise_in_motion(&rec.imu, &rec.fixes, &s, primed)
+                    .map_err(|e| ExperimentError::stage("reference", e))?;
+                let run = run_forward(&rec.imu.epochs, &rec.fixes, init, &s.filter)
+                    .map_err(|e| ExperimentError::stage("reference", e))?;
+                let sm = smooth(&run, &init, &s.filter)
+                    .map_err(|e| ExperimentError::stage("reference", e))?;
+                from_nav_states(sm.epochs.iter().map(|e| &e.nav))
+            };
+            let results: Vec<CaseRun> = [Case::Raw, Case::Room]
+                .par_iter()
+                .map(|&case| {
+                    let input = CaseInput {
+                        case,
+                        imu: rec.imu.clone(),
+                        fixes: &rec.fixes,
+                        session: session.clone(),
+                        prime: case == Case::Room,
+                    };
+                    run_case(input, sc, &windows, &reference, detail)
+                })
+                .collect();
+            Ok(VehicleRun {
+                run,
+                cases: results,
+                temperature_c: None,
+                reference: detail.then_some(reference),
+                fixes: detail.then(|| rec.fixes.clone()),
+            })
+        }
+        (None, _) => Err(sc.invalid("recorded vehicle data were not read")),
+    }
+}
