@@ -267,6 +267,69 @@ impl Annotation {
     }
 }
 
+/// Vertical bars (a bar chart, or one case of a grouped bar chart): bar `i`
+/// is centred on `x[i]` and reaches from the baseline to `y[i]`.
+///
+/// The baseline is 0 on a linear y axis and the bottom of the axis on a log
+/// y axis (log bars have no natural zero). Values the y axis cannot show
+/// (NaN and ±∞; zero and negatives on a log axis) get no bar; with
+/// [`missing_label`](Self::missing_label) that text is written at the foot
+/// of the empty slot instead, so a missing value is not mistaken for a small
+/// one. Bars use the next colour of [`PALETTE`] after the panel's series.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Bars {
+    /// Legend entry; an empty name keeps the bars out of the legend.
+    pub name: String,
+    /// Bar centres (data units).
+    pub x: Vec<f64>,
+    /// Bar tops (data units).
+    pub y: Vec<f64>,
+    /// Bar width in x data units; non-finite or non-positive: 0.8 × the
+    /// smallest spacing of `x` (0.8 for a single bar).
+    pub width: f64,
+    /// `None`: next colour of [`PALETTE`].
+    pub color: Option<Color>,
+    /// Text at the foot of a bar whose value cannot be shown (e.g. `"n/a"`).
+    pub missing_label: Option<String>,
+    /// Print each bar's value (3 significant digits) above it, where it fits.
+    pub value_labels: bool,
+}
+
+impl Bars {
+    /// Bars with automatic width and colour, no value labels.
+    pub fn new(name: impl Into<String>, x: Vec<f64>, y: Vec<f64>) -> Self {
+        Bars {
+            name: name.into(),
+            x,
+            y,
+            ..Default::default()
+        }
+    }
+
+    /// Bar width in x data units.
+    pub fn with_width(mut self, width: f64) -> Self {
+        self.width = width;
+        self
+    }
+
+    pub fn with_color(mut self, color: Color) -> Self {
+        self.color = Some(color);
+        self
+    }
+
+    /// Text shown where a value cannot be drawn.
+    pub fn with_missing_label(mut self, label: impl Into<String>) -> Self {
+        self.missing_label = Some(label.into());
+        self
+    }
+
+    /// Prints the values above the bars.
+    pub fn with_value_labels(mut self) -> Self {
+        self.value_labels = true;
+        self
+    }
+}
+
 /// Where a panel's legend goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum LegendPosition {
@@ -307,6 +370,8 @@ pub struct Plot {
     pub series: Vec<Series>,
     pub lines: Vec<Line>,
     pub annotations: Vec<Annotation>,
+    /// Bar groups, drawn above the grid and below lines and series.
+    pub bars: Vec<Bars>,
     /// Fixed x range (data units). `None`: fitted to the series (and, if
     /// there are no series, the lines), with a small margin.
     pub x_range: Option<(f64, f64)>,
@@ -317,6 +382,15 @@ pub struct Plot {
     pub x_scale: AxisScale,
     /// Scale of the y axis (default [`AxisScale::Log`]).
     pub y_scale: AxisScale,
+    /// Explicit x ticks `(position in data units, label)` replacing the
+    /// automatic ones, e.g. the categories of a bar chart. They get tick
+    /// marks and labels but no vertical grid lines; labels that would collide
+    /// are thinned to every n-th.
+    pub x_tick_labels: Option<Vec<(f64, String)>>,
+    /// One data unit is as long in x as in y (maps, trajectories): the
+    /// shorter range is widened about its centre. Only when both axes are
+    /// linear; ignored otherwise.
+    pub equal_aspect: bool,
 }
 
 impl Plot {
@@ -386,6 +460,23 @@ impl Plot {
 
     pub fn with_annotation(mut self, annotation: Annotation) -> Self {
         self.annotations.push(annotation);
+        self
+    }
+
+    pub fn with_bars(mut self, bars: Bars) -> Self {
+        self.bars.push(bars);
+        self
+    }
+
+    /// Replaces the automatic x ticks by labelled positions (categories).
+    pub fn with_x_tick_labels(mut self, ticks: Vec<(f64, String)>) -> Self {
+        self.x_tick_labels = Some(ticks);
+        self
+    }
+
+    /// Keeps one data unit equally long on both (linear) axes.
+    pub fn with_equal_aspect(mut self) -> Self {
+        self.equal_aspect = true;
         self
     }
 }

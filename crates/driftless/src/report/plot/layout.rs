@@ -1,7 +1,7 @@
 //! Figure → [`Scene`]: margins, axes, ticks, data, legend and label placement.
 
 use super::figure::{
-    AxisScale, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, LineStyle, MARKER_CYCLE,
+    AxisScale, Bars, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, LineStyle, MARKER_CYCLE,
     MarkerShape, PALETTE, Plot, Series,
 };
 use super::geom::{Pt, Rect, clip_polygon, clip_polyline, clip_segment, segment_hits_rect};
@@ -18,6 +18,11 @@ const AXIS_TITLE_SIZE: f64 = 13.5;
 const TICK_SIZE: f64 = 12.5;
 const LEGEND_SIZE: f64 = 12.0;
 const LABEL_SIZE: f64 = 12.0;
+/// Bar value labels and "missing value" notes.
+const BAR_TEXT_SIZE: f64 = 11.0;
+/// How far below the smallest bar a log y axis starts (decades), so that the
+/// smallest bar is still a visible bar and not a sliver.
+const LOG_BAR_FOOT: f64 = 0.3;
 
 const TEXT: Color = Color::rgb(0x1f, 0x1f, 0x1f);
 const FRAME: Color = Color::rgb(0x40, 0x40, 0x40);
@@ -159,6 +164,28 @@ fn panel_ranges(plot: &Plot) -> ((f64, f64), (f64, f64)) {
             }
         }
     }
+    // Bars: the x extent of every slot (shown or not), the tops, and on a
+    // linear y axis the baseline 0.
+    let mut bar_min_log: Option<f64> = None;
+    for b in &plot.bars {
+        let w = bar_width(b);
+        for (&x, &y) in b.x.iter().zip(&b.y) {
+            if !vx(x) {
+                continue;
+            }
+            xs.extend([x - w / 2.0, x + w / 2.0].into_iter().filter(|&e| vx(e)));
+            if vy(y) {
+                ys.push(y);
+                if plot.y_scale == AxisScale::Log {
+                    let l = y.log10();
+                    bar_min_log = Some(bar_min_log.map_or(l, |m: f64| m.min(l)));
+                }
+            }
+            if plot.y_scale == AxisScale::Linear {
+                ys.push(0.0);
+            }
+        }
+    }
     if xs.is_empty() {
         for l in &plot.lines {
             for (&x, &y) in l.x.iter().zip(&l.y) {
@@ -179,10 +206,115 @@ fn panel_ranges(plot: &Plot) -> ((f64, f64), (f64, f64)) {
             .or_else(|| linear_extent(vals).map(|(a, b)| linear_padded_range(a, b)))
             .unwrap_or((0.0, 1.0)),
     };
+    let xr = fit(plot.x_scale, plot.x_range, xs);
+    let mut yr = fit(plot.y_scale, plot.y_range, ys);
+    if let (Some(m), None) = (bar_min_log, plot.y_range) {
+        yr.0 = yr.0.min(m - LOG_BAR_FOOT);
+    }
+    (xr, yr)
+}
+
+/// Width of each bar of `b` in x data units (see [`Bars::width`]).
+fn bar_width(b: &Bars) -> f64 {
+    if b.width.is_finite() && b.width > 0.0 {
+        return b.width;
+    }
+    let mut xs: Vec<f64> = b.x.iter().copied().filter(|x| x.is_finite()).collect();
+    xs.sort_by(f64::total_cmp);
+    let gap = xs
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if gap.is_finite() { 0.8 * gap } else { 0.8 }
+}
+
+/// Ranges `(x, y)` widened about their centres so that one data unit spans
+/// as many pixels on both axes, for a plot area of `w` × `h` px.
+fn equalize(xr: (f64, f64), yr: (f64, f64), w: f64, h: f64) -> ((f64, f64), (f64, f64)) {
+    let (sx, sy) = ((xr.1 - xr.0) / w, (yr.1 - yr.0) / h);
+    let s = sx.max(sy);
+    if !(s.is_finite() && s > 0.0 && w > 0.0 && h > 0.0) {
+        return (xr, yr);
+    }
+    let (cx, cy) = (0.5 * (xr.0 + xr.1), 0.5 * (yr.0 + yr.1));
     (
-        fit(plot.x_scale, plot.x_range, xs),
-        fit(plot.y_scale, plot.y_range, ys),
+        (cx - s * w / 2.0, cx + s * w / 2.0),
+        (cy - s * h / 2.0, cy + s * h / 2.0),
     )
+}
+
+/// Explicit x ticks (categories): labelled major ticks at the given positions,
+/// every n-th label kept when neighbours would collide.
+fn category_ticks(ticks: &[(f64, String)], xm: &AxisMap) -> Vec<Tick> {
+    let mut out: Vec<(f64, Tick)> = ticks
+        .iter()
+        .filter_map(|(v, label)| {
+            let px = xm.px(*v)?;
+            let log = match xm.scale {
+                AxisScale::Log => v.log10(),
+                AxisScale::Linear => *v,
+            };
+            let label = label.trim();
+            Some((
+                px,
+                Tick {
+                    value: *v,
+                    log,
+                    major: true,
+                    label: (!label.is_empty()).then(|| label.to_owned()),
+                },
+            ))
+        })
+        .collect();
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let widest = out
+        .iter()
+        .filter_map(|(_, t)| t.label.as_deref())
+        .map(|l| text_width(l, TICK_SIZE))
+        .fold(0.0, f64::max);
+    let spacing = out
+        .windows(2)
+        .map(|w| w[1].0 - w[0].0)
+        .filter(|d| *d > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let step = if spacing.is_finite() {
+        ((widest + 8.0) / spacing).ceil().max(1.0) as usize
+    } else {
+        1
+    };
+    out.into_iter()
+        .enumerate()
+        .map(|(i, (_, mut t))| {
+            if i % step != 0 {
+                t.label = None;
+            }
+            t
+        })
+        .collect()
+}
+
+/// `v` to 3 significant digits without trailing zeros (`3.1`, `0.4`, `9800`;
+/// scientific notation outside 10⁻³ … 10⁵).
+fn format_value(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        return "0".to_owned();
+    }
+    if !(1e-3..1e5).contains(&a) {
+        return format!("{v:.2e}");
+    }
+    let d = (2 - a.log10().floor() as i32).clamp(0, 5) as usize;
+    let mut s = format!("{v:.d$}");
+    if s.contains('.') {
+        while s.ends_with('0') {
+            s.pop();
+        }
+        if s.ends_with('.') {
+            s.pop();
+        }
+    }
+    s
 }
 
 /// Things that labels and the legend should not cover.
@@ -295,22 +427,47 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
     let bottom = (cell.bottom() - bottom_margin).max(top + 20.0);
     let plot_h = bottom - top;
 
-    let (xr, yr) = panel_ranges(plot);
-    let y_ticks = axis_ticks(plot.y_scale, yr, plot_h, false);
-    let ytick_w = y_ticks
-        .iter()
-        .filter_map(|t| t.label.as_deref())
-        .map(|l| text_width(l, TICK_SIZE))
-        .fold(0.0, f64::max);
+    let (mut xr, mut yr) = panel_ranges(plot);
     let y_title_x = cell.x + 10.0 + AXIS_TITLE_SIZE * 0.78;
-    let left = if y_title.is_empty() {
-        cell.x + 12.0 + ytick_w + MAJOR_TICK + 4.0
-    } else {
-        y_title_x + AXIS_TITLE_SIZE * DESCENT_EM + 8.0 + ytick_w + MAJOR_TICK + 4.0
+    // The y tick labels set the left margin, which sets the plot width.
+    let y_side = |yr: (f64, f64)| {
+        let ticks = axis_ticks(plot.y_scale, yr, plot_h, false);
+        let ytick_w = ticks
+            .iter()
+            .filter_map(|t| t.label.as_deref())
+            .map(|l| text_width(l, TICK_SIZE))
+            .fold(0.0, f64::max);
+        let left = if y_title.is_empty() {
+            cell.x + 12.0 + ytick_w + MAJOR_TICK + 4.0
+        } else {
+            y_title_x + AXIS_TITLE_SIZE * DESCENT_EM + 8.0 + ytick_w + MAJOR_TICK + 4.0
+        };
+        (ticks, left)
     };
+    let width_from = |left: f64| (cell.right() - 24.0).max(left + 20.0) - left;
+    let (mut y_ticks, mut left) = y_side(yr);
+    let linear = plot.x_scale == AxisScale::Linear && plot.y_scale == AxisScale::Linear;
+    if plot.equal_aspect && linear {
+        // Widening y can widen its labels and so narrow the plot: iterate
+        // until the y range stops changing, then match x to the final width.
+        let (xr0, yr0) = (xr, yr);
+        for _ in 0..4 {
+            let (_, ny) = equalize(xr0, yr0, width_from(left), plot_h);
+            if ny == yr {
+                break;
+            }
+            yr = ny;
+            (y_ticks, left) = y_side(yr);
+        }
+        let per_px = (yr.1 - yr.0) / plot_h;
+        let cx = 0.5 * (xr0.0 + xr0.1);
+        let half = 0.5 * per_px * width_from(left);
+        if half.is_finite() && half > 0.0 {
+            xr = (cx - half, cx + half);
+        }
+    }
     let right = (cell.right() - 24.0).max(left + 20.0);
     let plot_w = right - left;
-    let x_ticks = axis_ticks(plot.x_scale, xr, plot_w, true);
 
     let area = Rect::new(left, top, plot_w, plot_h);
     let xm = AxisMap {
@@ -328,6 +485,11 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
         p1: top,
     };
     let map = |x: f64, y: f64| -> Option<Pt> { Some((xm.px(x)?, ym.px(y)?)) };
+    let category_x = plot.x_tick_labels.is_some();
+    let x_ticks = match &plot.x_tick_labels {
+        Some(t) => category_ticks(t, &xm),
+        None => axis_ticks(plot.x_scale, xr, plot_w, true),
+    };
 
     // Plot background and grid (minor first so major lines sit on top).
     items.push(Prim::Rect {
@@ -340,7 +502,7 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
     });
     for major in [false, true] {
         let color = if major { GRID_MAJOR } else { GRID_MINOR };
-        for t in x_ticks.iter().filter(|t| t.major == major) {
+        for t in x_ticks.iter().filter(|t| t.major == major && !category_x) {
             let x = xm.px_log(t.log);
             if x >= left - 0.01 && x <= right + 0.01 {
                 items.push(grid_line((x, top), (x, bottom), color));
@@ -355,6 +517,22 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
     }
 
     let mut obstacles = Obstacles::default();
+    let mut legend_entries = Vec::new();
+
+    // Bars (under lines and series).
+    for (bi, b) in plot.bars.iter().enumerate() {
+        let color = b
+            .color
+            .unwrap_or(PALETTE[(plot.series.len() + bi) % PALETTE.len()]);
+        push_bars(b, color, &xm, &ym, &area, &mut obstacles, items);
+        if !b.name.trim().is_empty() {
+            legend_entries.push(LegendEntry {
+                label: b.name.trim().to_owned(),
+                color,
+                sample: Sample::Bar,
+            });
+        }
+    }
 
     // Model / asymptote lines (under the data).
     let mut line_runs = Vec::with_capacity(plot.lines.len());
@@ -386,7 +564,6 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
     }
 
     // Series: connecting lines, error bars, markers.
-    let mut legend_entries = Vec::new();
     for (si, s) in plot.series.iter().enumerate() {
         let color = s.color.unwrap_or(PALETTE[si % PALETTE.len()]);
         let shape = s.marker.unwrap_or(MARKER_CYCLE[si % MARKER_CYCLE.len()]);
@@ -484,6 +661,11 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
                 color: line.color.unwrap_or(Color::DARK_GREY),
                 sample: Sample::Line {
                     dash: dash_of(line.style),
+                    width: line
+                        .width
+                        .filter(|w| w.is_finite() && *w > 0.0)
+                        .unwrap_or(1.5)
+                        .clamp(1.0, 6.0),
                 },
             });
         }
@@ -609,6 +791,113 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
             cell.y + 12.0 + TITLE_SIZE * CAP_HEIGHT_EM + 2.0,
         );
         items.push(text(at, &t, TITLE_SIZE, Anchor::Middle, true));
+    }
+}
+
+/// The bars of `b` clipped to `area`, their value labels and missing-value
+/// notes; every drawn box becomes an obstacle for the legend and labels.
+fn push_bars(
+    b: &Bars,
+    color: Color,
+    xm: &AxisMap,
+    ym: &AxisMap,
+    area: &Rect,
+    obstacles: &mut Obstacles,
+    items: &mut Vec<Prim>,
+) {
+    let w = bar_width(b);
+    let base = match ym.scale {
+        AxisScale::Linear => ym
+            .px(0.0)
+            .map_or(area.bottom(), |p| p.clamp(area.y, area.bottom())),
+        AxisScale::Log => area.bottom(),
+    };
+    let missing = b
+        .missing_label
+        .as_deref()
+        .map(str::trim)
+        .filter(|m| !m.is_empty());
+    let cap = BAR_TEXT_SIZE * CAP_HEIGHT_EM;
+    for (&x, &y) in b.x.iter().zip(&b.y) {
+        let (Some(a), Some(c)) = (xm.px(x - w / 2.0), xm.px(x + w / 2.0)) else {
+            continue;
+        };
+        let (x0, x1) = (a.min(c).max(area.x), a.max(c).min(area.right()));
+        if x1 - x0 < 0.5 {
+            continue;
+        }
+        let mid = 0.5 * (x0 + x1);
+        let Some(py) = ym.px(y) else {
+            if let Some(m) = missing {
+                // Just above the baseline (below it for a baseline at the top).
+                let at_y = if base - cap - 4.0 > area.y {
+                    base - 4.0
+                } else {
+                    base + cap + 4.0
+                };
+                items.push(Prim::Text {
+                    at: (mid, at_y),
+                    text: m.to_owned(),
+                    size: BAR_TEXT_SIZE,
+                    color: TEXT,
+                    anchor: Anchor::Middle,
+                    vertical: false,
+                    bold: false,
+                });
+                let tw = text_width(m, BAR_TEXT_SIZE);
+                obstacles
+                    .boxes
+                    .push(Rect::new(mid - tw / 2.0, at_y - cap, tw, cap));
+            }
+            continue;
+        };
+        let py = py.clamp(area.y, area.bottom());
+        let (y0, y1) = (py.min(base), py.max(base));
+        if y1 - y0 > 0.0 {
+            items.push(Prim::Rect {
+                x: x0,
+                y: y0,
+                w: x1 - x0,
+                h: y1 - y0,
+                fill: Some((color, 1.0)),
+                stroke: None,
+            });
+            obstacles.boxes.push(Rect::new(x0, y0, x1 - x0, y1 - y0));
+        }
+        if b.value_labels {
+            let t = format_value(y);
+            let tw = text_width(&t, BAR_TEXT_SIZE);
+            if tw > (x1 - x0) * 1.4 + 2.0 {
+                continue;
+            }
+            // Beyond the bar's end, or inside it (white) when that is off the area.
+            let upward = py <= base;
+            let outside = if upward { py - 3.0 } else { py + 3.0 + cap };
+            let fits = if upward {
+                outside - cap >= area.y
+            } else {
+                outside <= area.bottom()
+            };
+            let (at_y, fg) = if fits {
+                (outside, TEXT)
+            } else if upward {
+                (py + 3.0 + cap, Color::WHITE)
+            } else {
+                (py - 3.0, Color::WHITE)
+            };
+            items.push(Prim::Text {
+                at: (mid, at_y),
+                text: t,
+                size: BAR_TEXT_SIZE,
+                color: fg,
+                anchor: Anchor::Middle,
+                vertical: false,
+                bold: false,
+            });
+            obstacles
+                .boxes
+                .push(Rect::new(mid - tw / 2.0, at_y - cap, tw, cap));
+        }
     }
 }
 
@@ -778,7 +1067,9 @@ enum Sample {
     },
     Line {
         dash: Dash,
+        width: f64,
     },
+    Bar,
 }
 
 struct LegendEntry {
@@ -884,12 +1175,20 @@ fn draw_legend(
                     });
                 }
             }
-            Sample::Line { dash } => items.push(Prim::Path {
+            Sample::Line { dash, width } => items.push(Prim::Path {
                 pts: vec![(x0, cy), (x0 + LEGEND_SAMPLE, cy)],
                 color: e.color,
-                width: 1.5,
+                width,
                 dash,
                 opacity: 1.0,
+            }),
+            Sample::Bar => items.push(Prim::Rect {
+                x: x0 + LEGEND_SAMPLE / 2.0 - 7.0,
+                y: cy - 6.0,
+                w: 14.0,
+                h: 12.0,
+                fill: Some((e.color, 1.0)),
+                stroke: None,
             }),
         }
         items.push(Prim::Text {

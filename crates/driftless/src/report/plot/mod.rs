@@ -3,7 +3,9 @@
 //! with the `png` feature.
 //!
 //! The input types ([`Figure`], [`Plot`] (alias [`LogLogPlot`]), [`Series`],
-//! [`Line`], [`Annotation`]) are plain data, independent of the Allan types.
+//! [`Line`], [`Bars`], [`Annotation`]) are plain data, independent of the Allan
+//! types. A panel can also carry category x ticks ([`Plot::x_tick_labels`], e.g.
+//! under grouped bars) and keep equal axes ([`Plot::equal_aspect`], for maps).
 //! A figure is laid out once into a display list which both back-ends draw,
 //! so the SVG and the PNG show the same picture.
 //!
@@ -58,8 +60,8 @@ use std::path::Path;
 
 pub use error::PlotError;
 pub use figure::{
-    Annotation, AxisScale, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, Line, LineStyle,
-    LogLogPlot, MARKER_CYCLE, MarkerShape, PALETTE, Plot, Series,
+    Annotation, AxisScale, Bars, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, Line,
+    LineStyle, LogLogPlot, MARKER_CYCLE, MarkerShape, PALETTE, Plot, Series,
 };
 pub use svg::xml_escape;
 pub use text::text_width;
