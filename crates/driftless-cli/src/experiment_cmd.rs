@@ -197,6 +197,20 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
     let path = out.join("table1.md");
     std::fs::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
     written.push(path);
+    let figs = driftless::experiment::report::figures(p, r);
+    let fig_dir = out.join("figures");
+    std::fs::create_dir_all(&fig_dir).with_context(|| format!("creating {}", fig_dir.display()))?;
+    for (name, _, fig) in &figs {
+        let path = fig_dir.join(format!("{name}.svg"));
+        driftless::report::plot::write_figure(fig, &path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        written.push(path);
+    }
+    let html = driftless::experiment::report::html_report(p, r, &figs)?;
+    let path = out.join("report.html");
+    driftless::report::html::write_html(&path, &html)
+        .with_context(|| format!("writing {}", path.display()))?;
+    written.push(path);
     let path = out.join("experiment.json");
     std::fs::write(
         &path,

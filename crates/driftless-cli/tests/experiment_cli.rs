@@ -51,7 +51,10 @@ fn wrong_scenarios_fail_fast_without_output() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{name}: {err}");
         assert!(err.contains(expect), "{name}: {err}");
-        assert!(err.contains(&format!("{name}.toml")), "{name}: names the file: {err}");
+        assert!(
+            err.contains(&format!("{name}.toml")),
+            "{name}: names the file: {err}"
+        );
         assert!(!out_dir.exists(), "{name}: no partial output");
     }
 }

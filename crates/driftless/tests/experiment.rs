@@ -170,3 +170,40 @@ fn drive_0708_experiment() {
     }
     assert!(r.summary.ratio_room_over_thermal.is_none());
 }
+
+#[path = "common/chromium.rs"]
+mod chromium;
+
+/// The experiment's own HTML report (2 runs of the built-in scenario: every figure type)
+/// renders in headless Chromium: every image loads, the page is not blank.
+#[test]
+#[ignore = "needs chromium"]
+fn experiment_report_renders_in_chromium() {
+    let sc = ExperimentScenario::builtin_adi_like().expect("scenario");
+    let p = prepare(sc).expect("prepare");
+    let r = run_experiment(&p, Some(2), &|_, _, _| {}).expect("run");
+    let figs = driftless::experiment::report::figures(&p, &r);
+    let names: Vec<&str> = figs.iter().map(|f| f.0.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "trajectory",
+            "outage-errors",
+            "error-growth",
+            "thermal",
+            "allan",
+            "monte-carlo"
+        ]
+    );
+    let html = driftless::experiment::report::html_report(&p, &r, &figs).expect("html");
+    let dir = chromium::TempDir::new("experiment-report").expect("tmp");
+    let path = dir.0.join("report.html");
+    driftless::report::html::write_html(&path, &html).expect("write");
+    let (loaded, total) = chromium::image_check(&path).expect("chromium image check");
+    assert_eq!((loaded, total), (figs.len(), figs.len()));
+    let png = dir.0.join("report.png");
+    let shot = chromium::screenshot(&path, &png, 1200, 6000).expect("screenshot");
+    eprintln!("{shot:?}");
+    assert_eq!((shot.width, shot.height), (1200, 6000));
+    chromium::check_not_blank(&shot, 0.03).expect("screenshot content");
+}

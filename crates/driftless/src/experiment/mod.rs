@@ -17,6 +17,7 @@
 //! forward and smoothed solutions alike; the maximum is over every epoch in the window.
 
 pub mod monte_carlo;
+pub mod report;
 pub mod run;
 pub mod scenario;
 pub mod table;

@@ -11,16 +11,25 @@ use super::run::{Case, Prepared};
 use super::table::{Column, fmt_m, ratio_explanation, table_rows};
 use crate::io::nav::NavSolution;
 use crate::nav::earth::{meridian_radius_m, prime_vertical_radius_m};
-use crate::report::experiment_plots::{error_growth_figure, outage_bars_figure, trajectory_figure};
+use crate::report::experiment_plots::{
+    FIGURE_WIDTH, error_growth_figure, fit_to_width, outage_bars_figure, trajectory_figure,
+};
 use crate::report::html::HtmlReport;
 use crate::report::plot::{Figure, PlotError};
 use crate::report::{allan_plot, thermal_plot};
 
 /// North-east offsets (m) of a solution's epochs from an origin (lat, lon rad), on the
 /// ellipsoid's local radii at the origin — plenty for a figure of a few km.
-fn ne_of(sol: &NavSolution, idx: impl Iterator<Item = usize>, origin: (f64, f64, f64)) -> Vec<[f64; 2]> {
+fn ne_of(
+    sol: &NavSolution,
+    idx: impl Iterator<Item = usize>,
+    origin: (f64, f64, f64),
+) -> Vec<[f64; 2]> {
     let (lat0, lon0, h0) = origin;
-    let (m, n) = (meridian_radius_m(lat0) + h0, prime_vertical_radius_m(lat0) + h0);
+    let (m, n) = (
+        meridian_radius_m(lat0) + h0,
+        prime_vertical_radius_m(lat0) + h0,
+    );
     idx.map(|k| {
         [
             (sol.lon_rad[k] - lon0) * n * lat0.cos(),
@@ -43,13 +52,23 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
     if let Some(reference) = &run.reference
         && !reference.time_s.is_empty()
     {
-        let origin = (reference.lat_rad[0], reference.lon_rad[0], reference.height_m[0]);
+        let origin = (
+            reference.lat_rad[0],
+            reference.lon_rad[0],
+            reference.height_m[0],
+        );
         let n = reference.time_s.len();
         let step = (n / 3000).max(1);
         let full = ne_of(reference, (0..n).step_by(step), origin);
         let tracks: Vec<Vec<[f64; 2]>> = windows
             .iter()
-            .map(|w| ne_of(reference, indices_in(&reference.time_s, w.start_s, w.end_s), origin))
+            .map(|w| {
+                ne_of(
+                    reference,
+                    indices_in(&reference.time_s, w.start_s, w.end_s),
+                    origin,
+                )
+            })
             .collect();
         let solutions: Vec<(String, Vec<Vec<[f64; 2]>>)> = run
             .cases
@@ -105,7 +124,12 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
                 c.case.label().to_string(),
                 rep.outages
                     .iter()
-                    .map(|o| o.growth.iter().map(|g| (g.since_start_s, g.horizontal_m)).collect())
+                    .map(|o| {
+                        o.growth
+                            .iter()
+                            .map(|g| (g.since_start_s, g.horizontal_m))
+                            .collect()
+                    })
                     .collect(),
             ))
         })
@@ -124,7 +148,9 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
             thermal_plot::thermal_figure(soak, [("m/s²", 1.0), ("deg/s", 1.0f64.to_degrees())]),
         ));
     }
-    if let (Some(noise), Some(curves)) = (&r.noise, r.noise.as_ref().and_then(|n| n.curves.as_ref())) {
+    if let (Some(noise), Some(curves)) =
+        (&r.noise, r.noise.as_ref().and_then(|n| n.curves.as_ref()))
+    {
         let fits: Vec<Option<&crate::allan::fit::NoiseFit>> =
             noise.model.fits().map(Some).collect();
         out.push((
@@ -151,7 +177,11 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
                     c.case.label().to_string(),
                     r.runs
                         .iter()
-                        .map(|x| x.case(c.case).and_then(|y| y.forward_mean_end_m()).unwrap_or(f64::NAN))
+                        .map(|x| {
+                            x.case(c.case)
+                                .and_then(|y| y.forward_mean_end_m())
+                                .unwrap_or(f64::NAN)
+                        })
                         .collect(),
                 )
             })
@@ -165,7 +195,9 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
             outage_bars_figure(&run_labels, &per_run, "mean horizontal error [m]", true),
         ));
     }
-    out
+    out.into_iter()
+        .map(|(name, caption, fig)| (name, caption, fit_to_width(fig, FIGURE_WIDTH)))
+        .collect()
 }
 
 /// The HTML report: headline ratio, Table 1, Monte Carlo statistics, outage selection,
@@ -175,7 +207,11 @@ pub fn html_report(
     r: &ExperimentResult,
     figs: &[(String, String, Figure)],
 ) -> Result<HtmlReport, PlotError> {
-    let title = p.scenario.title.clone().unwrap_or_else(|| p.scenario.name.clone());
+    let title = p
+        .scenario
+        .title
+        .clone()
+        .unwrap_or_else(|| p.scenario.name.clone());
     let mut h = HtmlReport::new(&title);
     h.paragraph(&format!(
         "Scenario {} (seed {}): {} outage(s); {} Monte Carlo run(s); cases: {}.{}",
@@ -190,7 +226,8 @@ pub fn html_report(
             .collect::<Vec<_>>()
             .join(", "),
         match r.detailed.temperature_c {
-            Some((a, b)) => format!(" Sensor temperature during the vehicle run: {a:.1} → {b:.1} °C."),
+            Some((a, b)) =>
+                format!(" Sensor temperature during the vehicle run: {a:.1} → {b:.1} °C."),
             None => String::new(),
         }
     ));
@@ -204,10 +241,17 @@ pub fn html_report(
         h.table(&format!("Run 0: {} [m]", col.title()), &head, &rows);
     }
     h.heading(2, "Monte Carlo");
-    let head: Vec<String> = ["case", "mean [m]", "p5 [m]", "median [m]", "p95 [m]", "failed runs"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let head: Vec<String> = [
+        "case",
+        "mean [m]",
+        "p5 [m]",
+        "median [m]",
+        "p95 [m]",
+        "failed runs",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     let rows: Vec<Vec<String>> = r
         .summary
         .cases
@@ -221,7 +265,14 @@ pub fn html_report(
                 fmt_m(s.p95),
                 c.failed_runs.to_string(),
             ],
-            None => vec![c.label.clone(), "–".into(), "–".into(), "–".into(), "–".into(), c.failed_runs.to_string()],
+            None => vec![
+                c.label.clone(),
+                "–".into(),
+                "–".into(),
+                "–".into(),
+                "–".into(),
+                c.failed_runs.to_string(),
+            ],
         })
         .collect();
     h.table(
@@ -234,10 +285,17 @@ pub fn html_report(
     );
     h.heading(2, "Outages");
     let t0 = p.span_s.0;
-    let head: Vec<String> = ["outage", "start [s]", "end [s]", "chosen for", "dominant", "GNSS before [s]"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let head: Vec<String> = [
+        "outage",
+        "start [s]",
+        "end [s]",
+        "chosen for",
+        "dominant",
+        "GNSS before [s]",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     let rows: Vec<Vec<String>> = p
         .outages
         .iter()
@@ -253,7 +311,11 @@ pub fn html_report(
             ]
         })
         .collect();
-    h.table("Outage windows (s from the first reference epoch)", &head, &rows);
+    h.table(
+        "Outage windows (s from the first reference epoch)",
+        &head,
+        &rows,
+    );
     h.heading(2, "Figures");
     for (_, caption, fig) in figs {
         h.figure(caption, fig)?;
