@@ -12,7 +12,8 @@ use super::table::{Column, fmt_m, ratio_explanation, table_rows};
 use crate::io::nav::NavSolution;
 use crate::nav::earth::{meridian_radius_m, prime_vertical_radius_m};
 use crate::report::experiment_plots::{
-    FIGURE_WIDTH, error_growth_figure, fit_to_width, outage_bars_figure, trajectory_figure,
+    FIGURE_WIDTH, GrowthCurves, error_growth_figure, fit_to_width, outage_bars_figure,
+    trajectory_figure,
 };
 use crate::report::html::HtmlReport;
 use crate::report::plot::{Figure, PlotError};
@@ -115,7 +116,7 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
             .into(),
         outage_bars_figure(&labels, &bars, "horizontal error [m]", true),
     ));
-    let growth: Vec<(String, Vec<Vec<(f64, f64)>>)> = run
+    let growth: Vec<(String, GrowthCurves)> = run
         .cases
         .iter()
         .filter_map(|c| {
