@@ -143,8 +143,9 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
     if let Some(soak) = r.thermal.as_ref().and_then(|t| t.soak.as_ref()) {
         out.push((
             "thermal".into(),
-            "Bias and scale factor versus temperature from the chamber soak, with the cubic \
-             fit about 25 °C and its 95 % band (paper Figs. 3–4)"
+            "Bias and scale factor versus temperature from the chamber soak: dots are the \
+             per-step six-position / rate-table estimates, lines and bands the cubic fit about \
+             25 °C with its 95 % band (paper Figs. 3–4)"
                 .into(),
             thermal_plot::thermal_figure(soak, [("m/s²", 1.0), ("deg/s", 1.0f64.to_degrees())]),
         ));

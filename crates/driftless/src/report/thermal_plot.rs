@@ -49,14 +49,16 @@ pub fn thermal_figure(soak: &SoakCalibration, bias_units: [(&str, f64); 2]) -> F
                 let name = ["x", "y", "z"][axis];
                 p = p
                     .with_series(
-                        Series::new(format!("{name} fit ±95 %"), xs, y)
+                        // One legend entry per axis (line and band); the points (the
+                        // per-step estimates) stay out of the legend.
+                        Series::new(name, xs, y)
                             .with_band(lo, hi)
                             .with_marker(MarkerShape::None)
                             .with_color(color),
                     )
                     .with_series(
                         Series::new(
-                            name,
+                            "",
                             soak.temperatures_c.clone(),
                             s.values.iter().map(|v| v * factor).collect(),
                         )
