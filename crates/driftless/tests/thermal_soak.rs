@@ -8,33 +8,79 @@
 //!   and white noise, temperatures ascending (worst 1.37 % of swing, band coverage 93.3 %).
 //! * `every_noise_term`: every noise term of the preset, including its bias instability
 //!   and rate random walk (K = 160 °/h/√h gyro, 1.3e-4 m/s²/√s accel: ≈ 1.8e-3 rad/s and
-//!   0.018 m/s² over the 5.2-h protocol — 5 % of the gyro-z bias swing). Two measures:
+//!   0.018 m/s² over the 5.2-h protocol — 5 % of the gyro-z bias swing). Three measures:
 //!   - the bias series are fitted by generalised least squares with the drift covariance
 //!     from the Allan terms (`SoakDrift`), so the band covers the drift: without it the
 //!     coverage was 67.5 %;
 //!   - the set temperatures are visited in an interleaved order (k·7 mod 20), so the
 //!     drift is not a smooth function of temperature: ascending, the worst curve was
 //!     2.4–8.3 % of its swing over 8 seeds; interleaved, the thermal part of every bias
-//!     curve, Δb(T) = b(T) − b(25 °C), is within 1 % over 12 seeds.
+//!     curve, Δb(T) = b(T) − b(25 °C), is within 1 % over 12 seeds;
+//!   - the positions and rate segments run in the palindromic order
+//!     (`StepOrder::Palindromic`: +k and −k visits centred on the same instant, so a
+//!     linear drift cancels in the scale factors).
 //!
 //!   What remains (printed, not asserted — the bar is **not met** here): the value at
-//!   25 °C carries the random walk between turn-on and the steps (within 1.5σ of its
-//!   reported σ; worst full-curve error 1.6–4.1 % of swing over 12 seeds), and the
-//!   accelerometer scale factors (swing only 0.3 %) take up to 2.8 % of their swing from
-//!   drift between the ± positions of a step.
+//!   25 °C carries the slow noise realised before the first step's positions (rate
+//!   random walk since turn-on and the quasi-constant part of the flicker, which no
+//!   protocol can tell from the turn-on bias), and the accelerometer scale factors
+//!   (swing only 0.3 %) take flicker between the ± visits of a step. Measured by the
+//!   ignored `measure_protocols` over seeds 1 … 12 (worst of the 12 curves, RMS over
+//!   −25 … 70 °C in % of its swing, min / median / max; band coverage min–max):
+//!
+//!   | protocol                                  | worst curve        | coverage     |
+//!   |-------------------------------------------|--------------------|--------------|
+//!   | sequential                                | 1.57 / 2.10 / 4.10 | 91.2–100 %   |
+//!   | palindromic (this test)                   | 1.17 / 1.94 / 4.44 | 91.7–100 %   |
+//!   | sequential + 25 °C revisit                | 1.67 / 1.99 / 3.58 | 91.7–100 %   |
+//!   | palindromic + 25 °C revisit               | 1.24 / 2.11 / 3.48 | 91.7–100 %   |
+//!   | palindromic, 10-s first soak              | 1.19 / 2.06 / 2.90 | 91.7–100 %   |
+//!   | sequential + revisit, 10-s first soak     | 1.27 / 1.97 / 2.88 | 85.4–100 %   |
+//!   | palindromic + revisit, 10-s first soak    | 1.19 / 2.09 / 3.02 | 91.2–100 %   |
+//!
+//!   The worst curve is accelerometer scale z/y/x, gyro bias z or accelerometer bias z
+//!   (seeds 11–12: its offset at 25 °C). Gyro bias z is offset at 25 °C by 1.8–1.9 % of
+//!   its swing on each of the three seeds inspected (palindromic): the rate-table
+//!   segments are all turned with +k up, so the preset's gyro g-sensitivity G·f enters
+//!   their rows unmodelled. With `estimate_g_sensitivity` in the six-position fits
+//!   `deterministic_and_white_noise` drops from 1.37 to 0.60 % (coverage 92.1 %) and the
+//!   every-term runs give
+//!   1.33 / 2.02 / 4.10 (sequential), 1.23 / 1.64 / 4.44 (palindromic) and
+//!   0.92 / 1.57 / 2.48 % (palindromic + revisit, 10-s first soak; coverage 91.2–100 %)
+//!   — still above 2 % on some seeds (accelerometer scale z 2.48 %, bias z 2.30 %).
 
 use driftless::calib::six_position::SixPositionOptions;
-use driftless::sim::chamber::ChamberConfig;
+use driftless::sim::chamber::{ChamberConfig, StepOrder};
 use driftless::sim::chamber_manifest::SegmentKind;
 use driftless::sim::presets::Preset;
 use driftless::sim::sensor::{OutputKind, SensorModel};
 use driftless::thermal::FitOptions;
 use driftless::thermal::soak::{SoakDrift, soak_calibration};
 
+/// The chamber protocol of a run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Protocol {
+    /// Temperatures ascending, sequential order; deterministic errors, turn-on biases and
+    /// white noise only.
+    WhiteNoiseAscending,
+    /// Every noise term; temperatures interleaved (k·7 mod 20), positions and rate
+    /// segments in `order`; with `revisit`, an extra 25 °C step at the start and the end;
+    /// `first_soak_s` the soak of the first step (None: as every step); `estimate_g`
+    /// also fits the gyro g-sensitivity in each six-position calibration.
+    EveryTerm {
+        order: StepOrder,
+        revisit: bool,
+        first_soak_s: Option<f64>,
+        estimate_g: bool,
+    },
+}
+
 /// Figures of one run.
 struct Run {
     /// Worst RMS error over the range / swing, over the 12 series.
     worst: f64,
+    /// The series with that error.
+    worst_series: String,
     /// Worst RMS error of the thermal part (value at 25 °C removed) / swing, bias series.
     worst_bias_shape: f64,
     /// Fraction of (series, temperature) with the truth inside the 95 % band.
@@ -45,7 +91,7 @@ struct Run {
 
 #[test]
 fn deterministic_and_white_noise() {
-    let r = run(2026, false);
+    let r = run(2026, Protocol::WhiteNoiseAscending);
     assert!(r.worst <= 0.02, "worst {:.4}", r.worst);
     assert!(r.coverage >= 0.90, "band coverage {}", r.coverage);
     assert!(r.compensated_fraction <= 0.05, "{}", r.compensated_fraction);
@@ -54,7 +100,15 @@ fn deterministic_and_white_noise() {
 #[test]
 fn every_noise_term() {
     for seed in 1..=3 {
-        let r = run(seed, true);
+        let r = run(
+            seed,
+            Protocol::EveryTerm {
+                order: StepOrder::Palindromic,
+                revisit: false,
+                first_soak_s: None,
+                estimate_g: false,
+            },
+        );
         eprintln!(
             "seed {seed}: worst curve {:.2} %, worst bias thermal part {:.2} %, coverage {:.1} %",
             100.0 * r.worst,
@@ -76,8 +130,96 @@ fn every_noise_term() {
     }
 }
 
-fn run(seed: u64, all_terms: bool) -> Run {
+/// Measurement (not a check; `--ignored --nocapture`, ≈ 8 min): worst curve and band
+/// coverage over seeds 1 … 12 for the sequential and palindromic orders, without and
+/// with the 25 °C reference revisit and a 10-s first soak, with and without the gyro
+/// g-sensitivity in the six-position fits (figures in the module docs).
+#[test]
+#[ignore = "measurement: 168 runs"]
+fn measure_protocols() {
+    let mut table = Vec::new();
+    let mut configs = Vec::new();
+    for estimate_g in [false, true] {
+        for (order, revisit, first_soak_s) in [
+            (StepOrder::Sequential, false, None),
+            (StepOrder::Palindromic, false, None),
+            (StepOrder::Sequential, true, None),
+            (StepOrder::Palindromic, true, None),
+            (StepOrder::Palindromic, false, Some(10.0)),
+            (StepOrder::Sequential, true, Some(10.0)),
+            (StepOrder::Palindromic, true, Some(10.0)),
+        ] {
+            configs.push((order, revisit, first_soak_s, estimate_g));
+        }
+    }
+    for (order, revisit, first_soak_s, estimate_g) in configs {
+        let mut worst = Vec::new();
+        let mut cov = Vec::new();
+        let mut names = Vec::new();
+        for seed in 1..=12 {
+            let r = run(
+                seed,
+                Protocol::EveryTerm {
+                    order,
+                    revisit,
+                    first_soak_s,
+                    estimate_g,
+                },
+            );
+            eprintln!(
+                "MEASURE {order:?} revisit={revisit} first_soak={first_soak_s:?} G={estimate_g} seed {seed}: worst {:.2} % ({}), bias thermal part {:.2} %, coverage {:.1} %",
+                100.0 * r.worst,
+                r.worst_series,
+                100.0 * r.worst_bias_shape,
+                100.0 * r.coverage
+            );
+            worst.push(r.worst);
+            cov.push(r.coverage);
+            names.push(r.worst_series);
+        }
+        worst.sort_by(f64::total_cmp);
+        cov.sort_by(f64::total_cmp);
+        let median = 0.5 * (worst[5] + worst[6]);
+        table.push(format!(
+            "{order:?} revisit={revisit} first_soak={first_soak_s:?} G={estimate_g}: worst curve min {:.2} / median {:.2} / max {:.2} % of swing; coverage {:.1}–{:.1} %; worst series {names:?}",
+            100.0 * worst[0],
+            100.0 * median,
+            100.0 * worst[11],
+            100.0 * cov[0],
+            100.0 * cov[11]
+        ));
+    }
+    for line in table {
+        eprintln!("SUMMARY {line}");
+    }
+}
+
+fn run(seed: u64, protocol: Protocol) -> Run {
     let t0 = std::time::Instant::now();
+    let all_terms = protocol != Protocol::WhiteNoiseAscending;
+    let (step_order, temperatures_c, first_soak_s, estimate_g) = match protocol {
+        Protocol::WhiteNoiseAscending => (
+            StepOrder::Sequential,
+            (0..20).map(|i| -25.0 + 5.0 * i as f64).collect(),
+            None,
+            false,
+        ),
+        Protocol::EveryTerm {
+            order,
+            revisit,
+            first_soak_s,
+            estimate_g,
+        } => {
+            let mut t: Vec<f64> = (0..20)
+                .map(|i| -25.0 + 5.0 * ((i * 7) % 20) as f64)
+                .collect();
+            if revisit {
+                t.insert(0, 25.0);
+                t.push(25.0);
+            }
+            (order, t, first_soak_s, estimate_g)
+        }
+    };
     let proto = ChamberConfig {
         soak_s: 600.0,
         lag_tau_s: 60.0,
@@ -86,13 +228,9 @@ fn run(seed: u64, all_terms: bool) -> Run {
         rate_revolutions: 2,
         spin_s: 2.0,
         sample_rate_hz: 100.0,
-        temperatures_c: if all_terms {
-            (0..20)
-                .map(|i| -25.0 + 5.0 * ((i * 7) % 20) as f64)
-                .collect()
-        } else {
-            (0..20).map(|i| -25.0 + 5.0 * i as f64).collect()
-        },
+        temperatures_c,
+        step_order,
+        first_soak_s,
         ..ChamberConfig::default()
     }
     .build()
@@ -160,7 +298,8 @@ fn run(seed: u64, all_terms: bool) -> Run {
         }
         s / n.max(1) as f64
     };
-    let six = SixPositionOptions::from_manifest(&proto.manifest);
+    let mut six = SixPositionOptions::from_manifest(&proto.manifest);
+    six.estimate_g_sensitivity = estimate_g;
     // The drift model from the preset's Allan terms (what `driftless allan` reports).
     let drift = SoakDrift::from_sensor_config(&cfg);
     let t1 = std::time::Instant::now();
@@ -191,7 +330,11 @@ fn run(seed: u64, all_terms: bool) -> Run {
         }
     };
     let grid: Vec<f64> = (0..=95).map(|i| -25.0 + i as f64).collect();
+    // The distinct set temperatures (a revisited one counts once).
+    let mut temps = soak.temperatures_c.clone();
+    temps.dedup();
     let (mut worst, mut inside, mut total) = (0.0f64, 0usize, 0usize);
+    let mut worst_series = String::new();
     let mut worst_bias_shape = 0.0f64;
     for s in &soak.series {
         let tr: Vec<f64> = grid
@@ -226,7 +369,7 @@ fn run(seed: u64, all_terms: bool) -> Run {
             s.axis
         };
         let mut eff2 = 0.0;
-        for &t in &soak.temperatures_c {
+        for &t in &temps {
             let b = s.fit.band(t, 0.95).expect("band");
             let y = truth(s.triad, s.quantity, s.axis, t);
             let slow = if s.quantity == "bias" {
@@ -247,18 +390,22 @@ fn run(seed: u64, all_terms: bool) -> Run {
             rms,
             100.0 * rms / swing,
             100.0 * shape / swing,
-            (eff2 / soak.temperatures_c.len() as f64).sqrt(),
+            (eff2 / temps.len() as f64).sqrt(),
             ins,
-            soak.temperatures_c.len()
+            temps.len()
         );
-        worst = worst.max(rms / swing);
+        if rms / swing > worst {
+            worst = rms / swing;
+            worst_series = format!("{} {} {}", s.triad, s.quantity, ["x", "y", "z"][s.axis]);
+        }
         inside += ins;
-        total += soak.temperatures_c.len();
+        total += temps.len();
     }
     let frac = inside as f64 / total as f64;
     eprintln!(
-        "soak: {} temperatures, {} samples simulated in {sim_s:.2} s, calibrated + fitted in {fit_s:.3} s; worst RMS {:.2} % of swing; truth inside the 95 % band at {:.1} % of (series, temperature)",
+        "soak: {} steps at {} temperatures, {} samples simulated in {sim_s:.2} s, calibrated + fitted in {fit_s:.3} s; worst RMS {:.2} % of swing; truth inside the 95 % band at {:.1} % of (series, temperature)",
         soak.temperatures_c.len(),
+        temps.len(),
         out.len(),
         100.0 * worst,
         100.0 * frac
@@ -272,7 +419,7 @@ fn run(seed: u64, all_terms: bool) -> Run {
     let room = model.calibration().accel;
     let g = six.gravity_m_s2;
     let (mut e_comp, mut e_room, mut n) = (0.0, 0.0, 0usize);
-    for &t in &soak.temperatures_c {
+    for &t in &temps {
         let input = driftless::calib::six_position::SixPositionInput::from_manifest_columns(
             &proto.manifest,
             out.accel.each_ref().map(Vec::as_slice),
@@ -322,6 +469,7 @@ fn run(seed: u64, all_terms: bool) -> Run {
     let _ = std::fs::remove_file(&path);
     Run {
         worst,
+        worst_series,
         worst_bias_shape,
         coverage: frac,
         compensated_fraction: rc / rr,
@@ -391,4 +539,77 @@ fn a_temperature_missing_a_position_is_refused() {
         e.contains("5 set temperatures") && e.contains("order-4"),
         "{e}"
     );
+}
+
+/// Repeated visits: a set temperature visited in two steps gives two calibration points
+/// (each step calibrated from its own segments), and the palindromic order (every
+/// position and rate sign visited twice per step) gives, on noise-free data, the same
+/// per-step estimates as the sequential order.
+#[test]
+fn revisited_temperatures_and_palindromic_positions() {
+    let build = |order: StepOrder| {
+        ChamberConfig {
+            temperatures_c: vec![0.0, 20.0, 40.0, 60.0, 10.0, 0.0],
+            soak_s: 60.0,
+            lag_tau_s: 5.0,
+            position_dwell_s: 6.0,
+            move_s: 2.0,
+            rate_revolutions: 2,
+            spin_s: 1.0,
+            sample_rate_hz: 50.0,
+            step_order: order,
+            ..ChamberConfig::default()
+        }
+        .build()
+        .expect("protocol")
+    };
+    let cfg = Preset::AdiLike.config().deterministic_only();
+    let model = SensorModel::new(cfg).expect("model");
+    let mut results = Vec::new();
+    for order in [StepOrder::Sequential, StepOrder::Palindromic] {
+        let proto = build(order);
+        assert_eq!(proto.manifest.steps().len(), 6);
+        let curve = proto.temperature.curve().expect("temperature");
+        let out = model
+            .simulate(&proto.ideal(OutputKind::Rates), &curve, 1)
+            .expect("simulate");
+        let mut six = SixPositionOptions::from_manifest(&proto.manifest);
+        six.estimate_g_sensitivity = true;
+        let soak = soak_calibration(
+            &proto.manifest,
+            out.accel.each_ref().map(Vec::as_slice),
+            out.gyro.each_ref().map(Vec::as_slice),
+            1.0,
+            &six,
+            &FitOptions {
+                order: 3,
+                ..FitOptions::default()
+            },
+            None,
+        )
+        .expect("soak calibration");
+        assert_eq!(soak.temperatures_c, vec![0.0, 0.0, 10.0, 20.0, 40.0, 60.0]);
+        assert_eq!(soak.estimates.len(), 6);
+        // Every step: the deterministic truth (bias, scale) at its set temperature.
+        for (i, &t) in soak.temperatures_c.iter().enumerate() {
+            let (acc, gyr) = &soak.estimates[i];
+            for k in 0..3 {
+                let ab = acc.calibration.bias[k] - model.bias_at(3 + k, t);
+                let as_ = acc.forward_matrix.0[k][k] - 1.0 - model.scale_factor_at(3 + k, t);
+                let gb = gyr.calibration.bias[k] - model.bias_at(k, t);
+                let gs = gyr.forward_matrix.0[k][k] - 1.0 - model.scale_factor_at(k, t);
+                assert!(ab.abs() < 1e-6, "{order:?} {t} °C accel bias {k}: {ab}");
+                assert!(as_.abs() < 1e-6, "{order:?} {t} °C accel scale {k}: {as_}");
+                assert!(gb.abs() < 1e-7, "{order:?} {t} °C gyro bias {k}: {gb}");
+                assert!(gs.abs() < 1e-6, "{order:?} {t} °C gyro scale {k}: {gs}");
+            }
+        }
+        results.push(soak);
+    }
+    for (a, b) in results[0].estimates.iter().zip(&results[1].estimates) {
+        for k in 0..3 {
+            assert!((a.0.calibration.bias[k] - b.0.calibration.bias[k]).abs() < 1e-6);
+            assert!((a.1.calibration.bias[k] - b.1.calibration.bias[k]).abs() < 1e-7);
+        }
+    }
 }

@@ -18,6 +18,25 @@
 //!    down (back at "+k up" exactly);
 //! 4. rotate back to the home attitude.
 //!
+//! ## Palindromic order ([`StepOrder::Palindromic`])
+//!
+//! Steps 2 and 3 are run forwards and then backwards, each dwell half as long:
+//! positions −z, +z, +x, −x, +y, −y, −y, +y, −x, +x, +z, −z (the two −y halves are
+//! adjacent: one dwell split in two segments), `position_dwell_s`/2 each; rate segments
+//! +ω, −ω, −ω, +ω per axis, `rate_revolutions`/2 revolutions each (the two −ω halves are
+//! one continuous spin, split in two segments; `rate_revolutions` must be even; the two
+//! +ω ramp pairs against one −ω pair leave the table turned by ω·`spin_s` about the
+//! vertical, which the move to the next axis takes back). Every piece of the second
+//! half mirrors one of the first, so the sample-weighted
+//! mean time of the +k and −k visits (and of the +ω and −ω segments) is the same instant,
+//! the centre of the block. A bias that drifts linearly in time,
+//! b(t) = b(t_c) + ḃ·(t − t_c), then cancels exactly in the ± differences that give the
+//! scale factors, (f̄₊ − f̄₋)/(2g), and its mean over the block is b(t_c) for every
+//! orientation (the "ABBA" reversal design of drift-balanced comparisons, e.g. the
+//! weighing cycles of OIML R 111-1). A rate random walk, which is not linear, still
+//! leaves its increments between the adjacent visits of an axis, but those are half a
+//! dwell plus a move apart instead of one or more dwells.
+//!
 //! The IMU stays at a fixed location (no lever arm: the table rotates about the IMU),
 //! so the ideal specific force in every static position is exactly the normal gravity
 //! of the site along the up axis ([`ChamberManifest::gravity_m_s2`]). Over whole
@@ -66,6 +85,19 @@ use super::temperature::{ChamberStep, TemperatureProfile};
 use crate::nav::attitude::Quat;
 use crate::nav::earth;
 
+/// Order of the static positions and rate-table segments within a temperature step
+/// (module docs). TOML: `step_order = "sequential" | "palindromic"`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StepOrder {
+    /// Each position and each ±ω segment once, in protocol order (the default).
+    #[default]
+    Sequential,
+    /// The sequence, then the same sequence reversed, each dwell and each rate segment
+    /// half as long: linear drift cancels in the ± differences.
+    Palindromic,
+}
+
 /// Protocol settings (TOML-serialisable; every field has a default).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -74,14 +106,24 @@ pub struct ChamberConfig {
     pub temperatures_c: Vec<f64>,
     /// Soak dwell at the start of each step, s (default 3600).
     pub soak_s: f64,
-    /// Dwell per static position, s (default 60).
+    /// Soak dwell of the first step only, s (default: `soak_s`). The sensor starts at
+    /// the first set point (the temperature profile's initial value), so a run that
+    /// starts where the sensor was switched on — e.g. a reference step at ambient — can
+    /// measure at once; the earlier the first positions, the less rate random walk since
+    /// turn-on sits in every bias value ([`crate::thermal::soak`]).
+    pub first_soak_s: Option<f64>,
+    /// Dwell per static position, s (default 60; with [`StepOrder::Palindromic`] the
+    /// total over both visits of the position).
     pub position_dwell_s: f64,
     /// Duration of each rotation between positions, s (default 10).
     pub move_s: f64,
     /// Rate-table rate |ω|, deg/s (default 50; adjusted to whole samples, see module docs).
     pub rate_deg_s: f64,
-    /// Whole revolutions per rate segment (default 5).
+    /// Whole revolutions per rate segment (default 5; with [`StepOrder::Palindromic`] the
+    /// total over both segments of one sign, which must then be even).
     pub rate_revolutions: u32,
+    /// Order of the positions and rate segments within a step (default sequential).
+    pub step_order: StepOrder,
     /// Duration of each spin-up and spin-down, s (default 5).
     pub spin_s: f64,
     /// Sensor thermal time constant τ, s (default 300).
@@ -103,10 +145,12 @@ impl Default for ChamberConfig {
         ChamberConfig {
             temperatures_c: (0..20).map(|i| -25.0 + 5.0 * i as f64).collect(),
             soak_s: 3600.0,
+            first_soak_s: None,
             position_dwell_s: 60.0,
             move_s: 10.0,
             rate_deg_s: 50.0,
             rate_revolutions: 5,
+            step_order: StepOrder::Sequential,
             spin_s: 5.0,
             lag_tau_s: 300.0,
             ramp_c_per_min: None,
@@ -361,6 +405,9 @@ impl ChamberConfig {
         }
         check_pos("chamber.sample_rate_hz", self.sample_rate_hz)?;
         check_pos("chamber.soak_s", self.soak_s)?;
+        if let Some(d) = self.first_soak_s {
+            check_pos("chamber.first_soak_s", d)?;
+        }
         check_pos("chamber.position_dwell_s", self.position_dwell_s)?;
         check_pos("chamber.move_s", self.move_s)?;
         check_pos("chamber.rate_deg_s", self.rate_deg_s)?;
@@ -370,6 +417,14 @@ impl ChamberConfig {
             return Err(SensorSimError::invalid(
                 "chamber.rate_revolutions = 0",
                 "must be at least 1",
+            ));
+        }
+        let palindromic = self.step_order == StepOrder::Palindromic;
+        if palindromic && !self.rate_revolutions.is_multiple_of(2) {
+            return Err(SensorSimError::invalid(
+                format!("chamber.rate_revolutions = {}", self.rate_revolutions),
+                "must be even with step_order = \"palindromic\" (two segments of whole \
+                 revolutions per sign)",
             ));
         }
         if !self.latitude_deg.is_finite() || self.latitude_deg.abs() >= 90.0 {
@@ -397,9 +452,15 @@ impl ChamberConfig {
             }
         }
         // Every duration must be at least one sample.
+        let dwell = if palindromic {
+            0.5 * self.position_dwell_s
+        } else {
+            self.position_dwell_s
+        };
         for (name, d) in [
             ("soak_s", self.soak_s),
-            ("position_dwell_s", self.position_dwell_s),
+            ("first_soak_s", self.first_soak_s.unwrap_or(self.soak_s)),
+            ("position_dwell_s", dwell),
             ("move_s", self.move_s),
             ("spin_s", self.spin_s),
         ] {
@@ -419,8 +480,29 @@ impl ChamberConfig {
         let fs = self.sample_rate_hz;
         let dt = 1.0 / fs;
         let ns = |d: f64| ((d * fs).round() as u64).max(1);
-        let n_spin = ns(self.rate_revolutions as f64 * 360.0 / self.rate_deg_s);
-        let omega = self.rate_revolutions as f64 * std::f64::consts::TAU / (n_spin as f64 * dt);
+        // Positions and signed rates of one step, and the length of each dwell / spin.
+        let (positions, n_dwell, signs, revs): (Vec<SignedAxis>, u64, &[f64], u32) =
+            match self.step_order {
+                StepOrder::Sequential => (
+                    SignedAxis::POSITIONS.to_vec(),
+                    ns(self.position_dwell_s),
+                    &[1.0, -1.0],
+                    self.rate_revolutions,
+                ),
+                StepOrder::Palindromic => (
+                    SignedAxis::POSITIONS
+                        .iter()
+                        .chain(SignedAxis::POSITIONS.iter().rev())
+                        .copied()
+                        .collect(),
+                    ns(0.5 * self.position_dwell_s),
+                    &[1.0, -1.0, -1.0, 1.0],
+                    self.rate_revolutions / 2,
+                ),
+            };
+        let n_spin = ns(revs as f64 * 360.0 / self.rate_deg_s);
+        let omega = revs as f64 * std::f64::consts::TAU / (n_spin as f64 * dt);
+        let n_ramp = ns(self.spin_s);
         let home = SignedAxis::POSITIONS[0].c_bn_up();
         let mut b = Builder {
             dt,
@@ -431,32 +513,46 @@ impl ChamberConfig {
             segments: Vec::new(),
         };
         let mut steps = Vec::with_capacity(self.temperatures_c.len());
-        for &set_c in &self.temperatures_c {
+        for (i, &set_c) in self.temperatures_c.iter().enumerate() {
             let k_start = b.k;
             b.set_c = set_c;
             b.move_to(ns(self.move_s), home);
-            b.hold(ns(self.soak_s), SegmentKind::Soak);
-            for up in SignedAxis::POSITIONS {
+            let soak_s = match self.first_soak_s {
+                Some(d) if i == 0 => d,
+                _ => self.soak_s,
+            };
+            b.hold(ns(soak_s), SegmentKind::Soak);
+            // A position repeated back to back (the middle of the palindrome) needs no
+            // move: `move_to` skips it.
+            for &up in &positions {
                 b.move_to(ns(self.move_s), up.c_bn_up());
-                b.hold(ns(self.position_dwell_s), SegmentKind::Position { up });
+                b.hold(n_dwell, SegmentKind::Position { up });
             }
             for axis in BodyAxis::ALL {
                 let at = SignedAxis::new(axis, true).c_bn_up();
                 b.move_to(ns(self.move_s), at);
                 let u = axis.unit();
-                for w in [omega, -omega] {
-                    let c = b.c;
+                // Net angle of the program so far, in units of ω·Δt/2.
+                let mut net: i64 = 0;
+                for (i, &sign) in signs.iter().enumerate() {
+                    let s = sign as i64;
+                    let w = sign * omega;
                     let kind = SegmentKind::Rate {
                         axis,
                         rate_rad_s: w,
                     };
-                    b.push(
-                        ns(self.spin_s),
-                        u,
-                        Motion::SpinUp { rate_rad_s: w },
-                        rotate(c, u, 0.5 * w * ns(self.spin_s) as f64 * dt),
-                        SegmentKind::Move,
-                    );
+                    // Spin up unless the previous segment turns at the same rate.
+                    if i == 0 || signs[i - 1] != sign {
+                        let c = b.c;
+                        b.push(
+                            n_ramp,
+                            u,
+                            Motion::SpinUp { rate_rad_s: w },
+                            rotate(c, u, 0.5 * w * n_ramp as f64 * dt),
+                            SegmentKind::Move,
+                        );
+                        net += s * n_ramp as i64;
+                    }
                     let c = b.c;
                     b.push(
                         n_spin,
@@ -465,19 +561,28 @@ impl ChamberConfig {
                         rotate(c, u, w * n_spin as f64 * dt),
                         kind,
                     );
-                    // Back exactly at "+axis up" after the ±ω pair.
-                    let end = if w < 0.0 {
-                        at
-                    } else {
-                        rotate(b.c, u, 0.5 * w * ns(self.spin_s) as f64 * dt)
-                    };
-                    b.push(
-                        ns(self.spin_s),
-                        u,
-                        Motion::SpinDown { rate_rad_s: w },
-                        end,
-                        SegmentKind::Move,
-                    );
+                    net += 2 * s * n_spin as i64;
+                    // Spin down unless the next segment turns at the same rate. When the
+                    // net angle of the program is zero (sequential: one ramp pair per
+                    // sign) the last spin-down ends exactly at "+axis up"; otherwise
+                    // (palindromic: two +ω ramp pairs, one −ω) the table has turned by
+                    // ω·spin_s about the vertical axis, which `move_to` then undoes.
+                    let last = i + 1 == signs.len();
+                    if last || signs[i + 1] != sign {
+                        net += s * n_ramp as i64;
+                        let end = if last && net == 0 {
+                            at
+                        } else {
+                            rotate(b.c, u, 0.5 * w * n_ramp as f64 * dt)
+                        };
+                        b.push(
+                            n_ramp,
+                            u,
+                            Motion::SpinDown { rate_rad_s: w },
+                            end,
+                            SegmentKind::Move,
+                        );
+                    }
                 }
             }
             b.move_to(ns(self.move_s), home);
@@ -672,6 +777,112 @@ mod tests {
         };
         let total: f64 = steps.iter().map(|s| s.duration_s).sum();
         assert!((total - m.duration_s).abs() < 1e-9);
+    }
+
+    /// Palindromic order: every orientation twice per step with half the dwell, the two
+    /// visits of +k and −k (and of +ω and −ω) centred on the same instant, the attitude
+    /// continuous and back home, and the static shortcut still exact.
+    #[test]
+    fn palindromic_order_balances_the_mean_times() {
+        let cfg = ChamberConfig {
+            step_order: StepOrder::Palindromic,
+            rate_revolutions: 2,
+            ..small()
+        };
+        let p = cfg.build().unwrap();
+        let m = &p.manifest;
+        let steps = m.steps();
+        assert_eq!(steps.len(), 2);
+        let mean_time = |segs: &[&Segment]| {
+            let w: f64 = segs.iter().map(|s| s.duration_s()).sum();
+            segs.iter()
+                .map(|s| s.duration_s() * 0.5 * (s.start_s + s.end_s))
+                .sum::<f64>()
+                / w
+        };
+        for (set, range) in steps {
+            let segs = &m.segments[range];
+            let mut centre = None;
+            for axis in BodyAxis::ALL {
+                let pos = |positive: bool| -> Vec<&Segment> {
+                    let up = SignedAxis::new(axis, positive);
+                    segs.iter()
+                        .filter(|s| s.kind == SegmentKind::Position { up })
+                        .collect()
+                };
+                let (plus, minus) = (pos(true), pos(false));
+                assert_eq!((plus.len(), minus.len()), (2, 2), "{set} °C {axis:?}");
+                for s in plus.iter().chain(&minus) {
+                    assert!((s.duration_s() - 1.5).abs() < 1e-9);
+                }
+                let (tp, tm) = (mean_time(&plus), mean_time(&minus));
+                assert!((tp - tm).abs() < 1e-9, "{set} °C {axis:?}: {tp} vs {tm}");
+                // All orientations share one centre.
+                let c = *centre.get_or_insert(tp);
+                assert!((tp - c).abs() < 1e-9, "{set} °C {axis:?}: {tp} vs {c}");
+                let rate = |positive: bool| -> Vec<&Segment> {
+                    segs.iter()
+                        .filter(|s| {
+                            matches!(s.kind, SegmentKind::Rate { axis: a, rate_rad_s }
+                            if a == axis && (rate_rad_s > 0.0) == positive)
+                        })
+                        .collect()
+                };
+                let (plus, minus) = (rate(true), rate(false));
+                assert_eq!((plus.len(), minus.len()), (2, 2));
+                let (tp, tm) = (mean_time(&plus), mean_time(&minus));
+                assert!(
+                    (tp - tm).abs() < 1e-9,
+                    "{set} °C {axis:?} rates: {tp} vs {tm}"
+                );
+                for s in plus.iter().chain(&minus) {
+                    let SegmentKind::Rate { rate_rad_s, .. } = s.kind else {
+                        panic!()
+                    };
+                    let revs = rate_rad_s.abs() * s.duration_s() / std::f64::consts::TAU;
+                    assert!((revs - 1.0).abs() < 1e-12, "{revs}");
+                }
+            }
+        }
+        let tr = &p.trajectory;
+        for w in tr.pieces.windows(2) {
+            let (a, wa) = w[0].attitude(w[0].duration_s);
+            let (b, wb) = w[1].attitude(0.0);
+            for r in 0..3 {
+                for c in 0..3 {
+                    assert!((a.0[r][c] - b.0[r][c]).abs() < 1e-12);
+                }
+                assert!((wa[r] - wb[r]).abs() < 1e-12);
+            }
+        }
+        assert_eq!(tr.point(m.duration_s + 1.0).c_bn, Mat3::IDENTITY);
+        let fast = p.ideal(OutputKind::Rates);
+        let dt = 1.0 / m.sample_rate_hz;
+        let slow = IdealImu::from_trajectory(tr, OutputKind::Rates, 0.0, dt, p.n_samples());
+        for k in 0..p.n_samples() {
+            for i in 0..3 {
+                assert!((fast.gyro.at(k)[i] - slow.gyro.at(k)[i]).abs() < 1e-14);
+                assert!((fast.accel.at(k)[i] - slow.accel.at(k)[i]).abs() < 1e-14);
+            }
+        }
+        // Default order unchanged by the new field; the TOML name round-trips.
+        let text = toml::to_string(&cfg).unwrap();
+        assert!(text.contains("step_order = \"palindromic\""), "{text}");
+        assert_eq!(toml::from_str::<ChamberConfig>(&text).unwrap(), cfg);
+        assert_eq!(
+            toml::from_str::<ChamberConfig>("soak_s = 20.0\n")
+                .unwrap()
+                .step_order,
+            StepOrder::Sequential
+        );
+        // An odd revolution count cannot be halved into whole revolutions.
+        let e = ChamberConfig {
+            rate_revolutions: 3,
+            ..cfg
+        }
+        .build()
+        .unwrap_err();
+        assert!(e.to_string().contains("even"), "{e}");
     }
 
     #[test]

@@ -326,14 +326,46 @@ impl ChamberManifest {
         v
     }
 
-    /// The position segment with `up` at set temperature `set_c`.
+    /// The temperature steps in protocol order: maximal runs of consecutive segments at
+    /// one set temperature, as (set temperature, range of segment indices). A set
+    /// temperature visited twice (e.g. a reference temperature at the start and the end)
+    /// gives two steps.
+    pub fn steps(&self) -> Vec<(f64, Range<usize>)> {
+        let mut v: Vec<(f64, Range<usize>)> = Vec::new();
+        for (i, s) in self.segments.iter().enumerate() {
+            match v.last_mut() {
+                Some((t, r)) if *t == s.set_temperature_c && r.end == i => r.end = i + 1,
+                _ => v.push((s.set_temperature_c, i..i + 1)),
+            }
+        }
+        v
+    }
+
+    /// The manifest of step `segments` (a range from [`ChamberManifest::steps`]): the same
+    /// site constants and time axis, only those segments.
+    pub fn step_manifest(&self, segments: Range<usize>) -> ChamberManifest {
+        ChamberManifest {
+            format_version: self.format_version,
+            sample_rate_hz: self.sample_rate_hz,
+            latitude_deg: self.latitude_deg,
+            longitude_deg: self.longitude_deg,
+            height_m: self.height_m,
+            gravity_m_s2: self.gravity_m_s2,
+            earth_rate_rad_s: self.earth_rate_rad_s,
+            lag_tau_s: self.lag_tau_s,
+            duration_s: self.duration_s,
+            segments: self.segments[segments].to_vec(),
+        }
+    }
+
+    /// The (first) position segment with `up` at set temperature `set_c`.
     pub fn position(&self, set_c: f64, up: SignedAxis) -> Option<&Segment> {
         self.segments
             .iter()
             .find(|s| s.set_temperature_c == set_c && s.kind == SegmentKind::Position { up })
     }
 
-    /// The rate segment about `axis` with the sign of ω `positive` at `set_c`.
+    /// The (first) rate segment about `axis` with the sign of ω `positive` at `set_c`.
     pub fn rate(&self, set_c: f64, axis: BodyAxis, positive: bool) -> Option<&Segment> {
         self.segments.iter().find(|s| {
             s.set_temperature_c == set_c

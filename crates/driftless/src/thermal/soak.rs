@@ -15,6 +15,22 @@
 //! The temperature of each point is the set temperature (the protocol soaks until the
 //! sensor has settled; the manifest's soak is sized for that).
 //!
+//! # Steps and repeated visits
+//!
+//! A point is one temperature *step* of the manifest (a run of consecutive segments at
+//! one set temperature, [`ChamberManifest::steps`]), not one set temperature: a
+//! temperature visited twice (a reference step at the start and the end of the run, a
+//! common repeatability check) gives two points at the same T, each with its own time
+//! in the drift covariance below — the polynomial fits take repeated temperatures
+//! as they come. Within a step, every static position and rate segment is one
+//! observation of the six-position least squares: a position visited twice (the
+//! palindromic order of [`crate::sim::chamber::StepOrder`]) is a multi-position set with
+//! each orientation repeated. With the (nearly) equal standard errors of equal dwells the
+//! design is balanced and the estimate equals that of the visit-averaged six positions,
+//! so the drift cancellation of the palindrome carries over; the difference between the
+//! two visits of an orientation enters the χ² and so the calibration's scatter inflation
+//! ([`crate::calib::six_position`], Birge ratio) instead of being averaged away unseen.
+//!
 //! # Slow bias noise (drift) between temperature steps
 //!
 //! The six-position σ describes the scatter *within* one temperature step. The bias also
@@ -185,9 +201,10 @@ fn drift_covariance(times_s: &[f64], d: &ChannelDrift, average_s: f64, span_s: f
 /// Result of [`soak_calibration`].
 #[derive(Clone, Debug)]
 pub struct SoakCalibration {
-    /// Set temperatures, ascending, °C.
+    /// Set temperature of each step, ascending, °C (a temperature visited in two steps
+    /// appears twice, its steps in time order).
     pub temperatures_c: Vec<f64>,
-    /// The six-position estimates (accelerometer, gyro) at each set temperature.
+    /// The six-position estimates (accelerometer, gyro) of each step.
     pub estimates: Vec<(TriadEstimate, TriadEstimate)>,
     /// 12 series: accel bias x/y/z, accel scale x/y/z, gyro bias x/y/z, gyro scale x/y/z.
     pub series: Vec<SeriesFit>,
@@ -306,9 +323,10 @@ fn scale_sigma(est: &TriadEstimate) -> [f64; 3] {
     })
 }
 
-/// Six-position calibration at every set temperature of `manifest` (sample columns as
-/// for [`SixPositionInput::from_manifest_columns`]), then a polynomial fit of every bias
-/// and scale series weighted by its standard errors — with `drift`, the bias series by
+/// Six-position calibration at every temperature step of `manifest`
+/// ([`ChamberManifest::steps`]; sample columns as for
+/// [`SixPositionInput::from_manifest_columns`]), then a polynomial fit of every bias and
+/// scale series weighted by its standard errors — with `drift`, the bias series by
 /// generalised least squares with the drift covariance (module docs).
 pub fn soak_calibration(
     manifest: &ChamberManifest,
@@ -319,37 +337,35 @@ pub fn soak_calibration(
     fit_opts: &FitOptions,
     drift: Option<&SoakDrift>,
 ) -> Result<SoakCalibration, SoakError> {
-    let mut temps: Vec<f64> = manifest
-        .segments
-        .iter()
-        .map(|s| s.set_temperature_c)
-        .collect();
-    temps.sort_by(f64::total_cmp);
-    temps.dedup();
-    if temps.len() < fit_opts.order + 2 {
+    // One calibration point per step, ascending in temperature (a temperature visited
+    // twice keeps its steps in time order).
+    let mut steps = manifest.steps();
+    steps.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let temps: Vec<f64> = steps.iter().map(|s| s.0).collect();
+    let mut distinct = temps.clone();
+    distinct.dedup();
+    if distinct.len() < fit_opts.order + 2 {
         return Err(SoakError::TooFewTemperatures {
-            found: temps.len(),
+            found: distinct.len(),
             order: fit_opts.order,
         });
     }
-    // per temperature: (accel, gyro) estimates
+    // per step: (accel, gyro) estimates
     let mut ests = Vec::with_capacity(temps.len());
-    for &t in &temps {
-        let input = SixPositionInput::from_manifest_columns(manifest, accel, gyro, scale, t)
+    for (t, range) in &steps {
+        let t = *t;
+        let step = manifest.step_manifest(range.clone());
+        let input = SixPositionInput::from_manifest_columns(&step, accel, gyro, scale, t)
             .map_err(|source| SoakError::Calibration { t_c: t, source })?;
         let cal =
             calibrate(&input, six).map_err(|source| SoakError::Calibration { t_c: t, source })?;
         ests.push((cal.accel, cal.gyro));
     }
-    // Per temperature: mid-time and total duration of its static positions.
+    // Per step: mid-time and total duration of its static positions.
     let (mut times, mut average_s) = (Vec::with_capacity(temps.len()), f64::INFINITY);
-    for &t in &temps {
+    for (_, range) in &steps {
         let (mut w, mut tw) = (0.0, 0.0);
-        for g in manifest
-            .segments
-            .iter()
-            .filter(|g| g.set_temperature_c == t)
-        {
+        for g in &manifest.segments[range.clone()] {
             if matches!(g.kind, SegmentKind::Position { .. }) {
                 let d = g.end_s - g.start_s;
                 w += d;
