@@ -179,6 +179,8 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
         (Column::ForwardEnd, "table1.csv"),
         (Column::ForwardMax, "table1-max.csv"),
         (Column::SmoothedMax, "table1-smoothed.csv"),
+        (Column::ForwardEndHeight, "table1-height.csv"),
+        (Column::ForwardEndHeading, "table1-heading.csv"),
     ] {
         let (h, rows) = table_rows(p, &r.detailed, col);
         md.push_str(&format!("## Table 1 (run 0): {}\n\n", col.title()));

@@ -315,22 +315,30 @@ mod tests {
 
     #[test]
     fn bootstrap_interval_brackets_the_ratio_and_shrinks_with_runs() {
-        // num = 3·den + noise: ratio ≈ 3.
+        // Runs in pairs with the same denominator and multipliers u, 2 − u (u ∈ [0.8,
+        // 1.2)): num = 3·den·u, so the sample ratio of means is exactly 3 while single
+        // runs scatter ±20 %.
         let mut s = 7u64;
         let mut u = || {
             s = splitmix64(s);
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
-        let mk = |n: usize, u: &mut dyn FnMut() -> f64| {
-            let den: Vec<f64> = (0..n).map(|_| 1.0 + u()).collect();
-            let num: Vec<f64> = den.iter().map(|d| 3.0 * d * (0.8 + 0.4 * u())).collect();
+        let mk = |pairs: usize, u: &mut dyn FnMut() -> f64| {
+            let (mut num, mut den) = (Vec::new(), Vec::new());
+            for _ in 0..pairs {
+                let d = 1.0 + u();
+                let m = 0.8 + 0.4 * u();
+                num.extend([3.0 * d * m, 3.0 * d * (2.0 - m)]);
+                den.extend([d, d]);
+            }
             (num, den)
         };
-        let (n1, d1) = mk(20, &mut u);
-        let (n2, d2) = mk(2000, &mut u);
+        let (n1, d1) = mk(10, &mut u);
+        let (n2, d2) = mk(1000, &mut u);
         let a = ratio_interval(&n1, &d1, 0.95, 1).expect("a");
         let b = ratio_interval(&n2, &d2, 0.95, 1).expect("b");
         assert!(a.lo < a.ratio && a.ratio < a.hi, "{a:?}");
+        assert!((a.ratio - 3.0).abs() < 1e-12 && (b.ratio - 3.0).abs() < 1e-12);
         assert!(b.lo < 3.0 && 3.0 < b.hi, "{b:?}");
         assert!(b.hi - b.lo < 0.3 * (a.hi - a.lo), "{a:?} {b:?}");
         // Failed runs (NaN) are dropped pairwise.

@@ -238,9 +238,15 @@ pub fn html_report(
         h.paragraph(&line);
     }
     h.heading(2, "Table 1");
-    for col in [Column::ForwardEnd, Column::ForwardMax, Column::SmoothedMax] {
+    for col in [
+        Column::ForwardEnd,
+        Column::ForwardMax,
+        Column::SmoothedMax,
+        Column::ForwardEndHeight,
+        Column::ForwardEndHeading,
+    ] {
         let (head, rows) = table_rows(p, &r.detailed, col);
-        h.table(&format!("Run 0: {} [m]", col.title()), &head, &rows);
+        h.table(&format!("Run 0: {}", col.title()), &head, &rows);
     }
     h.heading(2, "Monte Carlo");
     let head: Vec<String> = [

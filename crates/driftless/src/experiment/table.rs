@@ -19,6 +19,12 @@ pub enum Column {
     /// Largest horizontal error inside the outage, smoothed (its end error is pinned by
     /// the fix after the window, so the maximum is the informative figure).
     SmoothedMax,
+    /// Height error (solution − reference) at the end of the outage, forward filter;
+    /// mean and RMS rows of |error|.
+    ForwardEndHeight,
+    /// Heading error at the end of the outage, forward filter, deg; mean and RMS rows of
+    /// |error|.
+    ForwardEndHeading,
 }
 
 impl Column {
@@ -28,6 +34,16 @@ impl Column {
             Column::ForwardEnd => "end-of-outage horizontal error, forward filter (real time)",
             Column::ForwardMax => "maximum horizontal error inside the outage, forward filter",
             Column::SmoothedMax => "maximum horizontal error inside the outage, smoothed",
+            Column::ForwardEndHeight => "end-of-outage height error, forward filter",
+            Column::ForwardEndHeading => "end-of-outage heading error, forward filter (deg)",
+        }
+    }
+
+    /// Unit of the cells.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Column::ForwardEndHeading => "deg",
+            _ => "m",
         }
     }
 }
@@ -35,7 +51,10 @@ impl Column {
 fn report(run: &VehicleRun, case: Case, col: Column) -> Option<&OutageReport> {
     let c = run.case(case)?;
     match col {
-        Column::ForwardEnd | Column::ForwardMax => c.forward.as_ref().ok(),
+        Column::ForwardEnd
+        | Column::ForwardMax
+        | Column::ForwardEndHeight
+        | Column::ForwardEndHeading => c.forward.as_ref().ok(),
         Column::SmoothedMax => c.smoothed.as_ref()?.as_ref().ok(),
     }
 }
@@ -48,7 +67,11 @@ pub fn table_rows(p: &Prepared, run: &VehicleRun, col: Column) -> (Vec<String>, 
         "start [s]".to_string(),
         "dynamics".to_string(),
     ];
-    header.extend(cases.iter().map(|c| format!("{} [m]", c.label())));
+    header.extend(
+        cases
+            .iter()
+            .map(|c| format!("{} [{}]", c.label(), col.unit())),
+    );
     let t0 = p.span_s.0;
     let mut rows = Vec::new();
     for (i, o) in p.outages.iter().enumerate() {
@@ -61,19 +84,29 @@ pub fn table_rows(p: &Prepared, run: &VehicleRun, col: Column) -> (Vec<String>, 
             row.push(match report(run, c, col).and_then(|r| r.outages.get(i)) {
                 Some(e) => fmt_m(match col {
                     Column::ForwardEnd => e.end_horizontal_m,
-                    _ => e.max_horizontal_m,
+                    Column::ForwardEndHeight => e.end_height_m,
+                    Column::ForwardEndHeading => e.end_heading_deg.unwrap_or(f64::NAN),
+                    Column::ForwardMax | Column::SmoothedMax => e.max_horizontal_m,
                 }),
                 None => failed_cell(run, c, col),
             });
         }
         rows.push(row);
     }
+    let abs = matches!(col, Column::ForwardEndHeight | Column::ForwardEndHeading);
     for (name, pick) in [("mean", 0usize), ("RMS", 1)] {
-        let mut row = vec![name.to_string(), String::new(), String::new()];
+        let name = if abs {
+            format!("{name} |·|")
+        } else {
+            name.to_string()
+        };
+        let mut row = vec![name, String::new(), String::new()];
         for &c in &cases {
             let stat = report(run, c, col).and_then(|r| match col {
                 Column::ForwardEnd => r.summary.end_horizontal_m,
-                _ => r.summary.max_horizontal_m,
+                Column::ForwardEndHeight => r.summary.end_height_abs_m,
+                Column::ForwardEndHeading => r.summary.end_heading_abs_deg,
+                Column::ForwardMax | Column::SmoothedMax => r.summary.max_horizontal_m,
             });
             row.push(match stat {
                 Some(s) => fmt_m(if pick == 0 { s.mean } else { s.rms }),
@@ -94,7 +127,7 @@ fn failed_cell(run: &VehicleRun, c: Case, col: Column) -> String {
     }
 }
 
-/// Metres with sensible digits: 3 significant below 100 m, whole metres above.
+/// Metres (or degrees) with sensible digits: 3 significant below 100, whole units above.
 pub fn fmt_m(v: f64) -> String {
     if !v.is_finite() {
         "n/a".into()
