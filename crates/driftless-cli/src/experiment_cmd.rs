@@ -130,27 +130,10 @@ fn print_human(p: &Prepared, r: &ExperimentResult) {
         "Monte Carlo over {} run(s): mean end-of-outage horizontal error per run, forward filter [m]",
         s.runs
     );
-    let mut t = crate::output::Table::new(["case", "mean", "p5", "median", "p95", "failed runs"]);
-    for c in &s.cases {
-        let f = |v: f64| driftless::experiment::table::fmt_m(v);
-        match &c.forward_mean_end_m {
-            Some(sp) => t.row(vec![
-                c.label.clone(),
-                f(sp.mean),
-                f(sp.p5),
-                f(sp.p50),
-                f(sp.p95),
-                c.failed_runs.to_string(),
-            ]),
-            None => t.row(vec![
-                c.label.clone(),
-                "–".into(),
-                "–".into(),
-                "–".into(),
-                "–".into(),
-                c.failed_runs.to_string(),
-            ]),
-        }
+    let (head, rows) = s.table();
+    let mut t = crate::output::Table::new(head);
+    for row in rows {
+        t.row(row);
     }
     print!("{}", t.render());
     for c in &s.cases {

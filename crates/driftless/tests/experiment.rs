@@ -65,13 +65,7 @@ fn builtin_monte_carlo_thermal_model_pays() {
     );
     assert!(q.lo <= q.ratio && q.ratio <= q.hi);
     // Run 0 is complete: nine rows + mean + RMS per table, every case smoothed.
-    for col in [
-        Column::ForwardEnd,
-        Column::ForwardMax,
-        Column::SmoothedMax,
-        Column::ForwardEndHeight,
-        Column::ForwardEndHeading,
-    ] {
+    for col in Column::ALL {
         let (h, rows) = table_rows(&p, &r.detailed, col);
         assert_eq!(h.len(), 6);
         assert_eq!(rows.len(), 11);

@@ -21,6 +21,26 @@ use super::run::{
     vehicle_run,
 };
 
+impl ExperimentResult {
+    /// Per case (run 0's order): label and each run's mean end-of-outage horizontal
+    /// error of the forward filter (`None` where the case failed).
+    pub fn per_run_forward_means(&self) -> Vec<(String, Vec<Option<f64>>)> {
+        self.detailed
+            .cases
+            .iter()
+            .map(|c| {
+                (
+                    c.case.label().to_string(),
+                    self.runs
+                        .iter()
+                        .map(|run| run.case(c.case).and_then(|x| x.forward_mean_end_m()))
+                        .collect(),
+                )
+            })
+            .collect()
+    }
+}
+
 /// Everything an experiment produced.
 #[derive(Debug)]
 pub struct ExperimentResult {
@@ -109,6 +129,37 @@ pub struct RatioInterval {
     pub confidence: f64,
     /// Runs used (those where both cases succeeded).
     pub runs: usize,
+}
+
+impl MonteCarloSummary {
+    /// The per-case statistics as a table: header and rows (metres).
+    pub fn table(&self) -> (Vec<String>, Vec<Vec<String>>) {
+        let header = [
+            "case",
+            "mean [m]",
+            "p5 [m]",
+            "median [m]",
+            "p95 [m]",
+            "failed runs",
+        ]
+        .map(String::from)
+        .to_vec();
+        let f = super::table::fmt_m;
+        let rows = self
+            .cases
+            .iter()
+            .map(|c| {
+                let mut row = vec![c.label.clone()];
+                match &c.forward_mean_end_m {
+                    Some(s) => row.extend([f(s.mean), f(s.p5), f(s.p50), f(s.p95)]),
+                    None => row.extend(["–"; 4].map(String::from)),
+                }
+                row.push(c.failed_runs.to_string());
+                row
+            })
+            .collect();
+        (header, rows)
+    }
 }
 
 /// Statistics over the runs.

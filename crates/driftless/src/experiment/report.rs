@@ -8,7 +8,7 @@
 
 use super::monte_carlo::ExperimentResult;
 use super::run::{Case, Prepared};
-use super::table::{Column, fmt_m, ratio_explanation, table_rows};
+use super::table::{Column, ratio_explanation, table_rows};
 use crate::io::nav::NavSolution;
 use crate::nav::earth::{meridian_radius_m, prime_vertical_radius_m};
 use crate::report::experiment_plots::{
@@ -171,22 +171,10 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
     }
     if r.runs.len() > 1 {
         let run_labels: Vec<String> = (1..=r.runs.len()).map(|i| i.to_string()).collect();
-        let per_run: Vec<(String, Vec<f64>)> = run
-            .cases
-            .iter()
-            .map(|c| {
-                (
-                    c.case.label().to_string(),
-                    r.runs
-                        .iter()
-                        .map(|x| {
-                            x.case(c.case)
-                                .and_then(|y| y.forward_mean_end_m())
-                                .unwrap_or(f64::NAN)
-                        })
-                        .collect(),
-                )
-            })
+        let per_run: Vec<(String, Vec<f64>)> = r
+            .per_run_forward_means()
+            .into_iter()
+            .map(|(l, v)| (l, v.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect()))
             .collect();
         out.push((
             "monte-carlo".into(),
@@ -238,51 +226,12 @@ pub fn html_report(
         h.paragraph(&line);
     }
     h.heading(2, "Table 1");
-    for col in [
-        Column::ForwardEnd,
-        Column::ForwardMax,
-        Column::SmoothedMax,
-        Column::ForwardEndHeight,
-        Column::ForwardEndHeading,
-    ] {
+    for col in Column::ALL {
         let (head, rows) = table_rows(p, &r.detailed, col);
         h.table(&format!("Run 0: {}", col.title()), &head, &rows);
     }
     h.heading(2, "Monte Carlo");
-    let head: Vec<String> = [
-        "case",
-        "mean [m]",
-        "p5 [m]",
-        "median [m]",
-        "p95 [m]",
-        "failed runs",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    let rows: Vec<Vec<String>> = r
-        .summary
-        .cases
-        .iter()
-        .map(|c| match &c.forward_mean_end_m {
-            Some(s) => vec![
-                c.label.clone(),
-                fmt_m(s.mean),
-                fmt_m(s.p5),
-                fmt_m(s.p50),
-                fmt_m(s.p95),
-                c.failed_runs.to_string(),
-            ],
-            None => vec![
-                c.label.clone(),
-                "–".into(),
-                "–".into(),
-                "–".into(),
-                "–".into(),
-                c.failed_runs.to_string(),
-            ],
-        })
-        .collect();
+    let (head, rows) = r.summary.table();
     h.table(
         &format!(
             "Per-run mean end-of-outage horizontal error, forward filter, over {} run(s)",

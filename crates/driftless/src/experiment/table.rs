@@ -28,6 +28,15 @@ pub enum Column {
 }
 
 impl Column {
+    /// Every table, in report order.
+    pub const ALL: [Column; 5] = [
+        Column::ForwardEnd,
+        Column::ForwardMax,
+        Column::SmoothedMax,
+        Column::ForwardEndHeight,
+        Column::ForwardEndHeading,
+    ];
+
     /// Title.
     pub fn title(self) -> &'static str {
         match self {
@@ -242,20 +251,7 @@ impl<'a> ExperimentDocument<'a> {
                 gnss_rejected: c.gnss_rejected,
             })
             .collect();
-        let per_run = r
-            .detailed
-            .cases
-            .iter()
-            .map(|c| {
-                (
-                    c.case.label().to_string(),
-                    r.runs
-                        .iter()
-                        .map(|run| run.case(c.case).and_then(|x| x.forward_mean_end_m()))
-                        .collect(),
-                )
-            })
-            .collect();
+        let per_run = r.per_run_forward_means();
         ExperimentDocument {
             scenario: &p.scenario.name,
             title: p.scenario.title.as_deref(),
