@@ -204,7 +204,20 @@ fn soak(s: SoakArgs) -> Result<()> {
         )
         .with_context(|| format!("writing {}", p.display()))?;
     }
+    let g_json = |g: &driftless::calib::six_position::GSensitivityEstimate| {
+        serde_json::json!({
+            "matrix": g.matrix_raw_per_m_s2.0,
+            "sigma": g.sigma_raw_per_m_s2,
+        })
+    };
+    let g_mean = soak.gyro_g_sensitivity_mean();
     if s.json {
+        let g_steps: Vec<Option<serde_json::Value>> = soak
+            .gyro_g_sensitivity
+            .iter()
+            .map(|g| g.as_ref().map(g_json))
+            .collect();
+        let g_mean = g_mean.as_ref().map(g_json);
         let series: Vec<serde_json::Value> = soak
             .series
             .iter()
@@ -224,6 +237,10 @@ fn soak(s: SoakArgs) -> Result<()> {
                 "order": s.order,
                 "model_id": id,
                 "series": series,
+                // per step (order of temperatures_c), raw gyro units per m/s²; null when
+                // not estimated
+                "gyro_g_sensitivity": g_steps,
+                "gyro_g_sensitivity_mean": g_mean,
                 "seconds": secs,
             }))?
         );
@@ -259,6 +276,23 @@ fn soak(s: SoakArgs) -> Result<()> {
         tab.row(row);
     }
     print!("{}", tab.render());
+    if let Some(g) = &g_mean {
+        // Estimated per step (rate segments all +k up); not part of the model file.
+        let d = |i: usize| {
+            format!(
+                "{} ± {}",
+                crate::output::sci(g.matrix_raw_per_m_s2.0[i][i]),
+                crate::output::sci(g.sigma_raw_per_m_s2[i][i])
+            )
+        };
+        println!(
+            "gyro g-sensitivity (mean over {} steps, per m/s^2): G_xx {}, G_yy {}, G_zz {}",
+            soak.gyro_g_sensitivity.len(),
+            d(0),
+            d(1),
+            d(2)
+        );
+    }
     for p in [&s.out, &s.plot].into_iter().flatten() {
         println!("wrote {}", p.display());
     }

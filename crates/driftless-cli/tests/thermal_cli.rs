@@ -44,6 +44,22 @@ fn soak_on_a_simulated_chamber_run() {
     let cfg = driftless::sim::presets::Preset::AdiLike.config();
     let want = cfg.gyro.bias_poly_rad_s[0][1];
     assert!((c1 - want).abs() <= 1e-9 * want.abs(), "c1 {c1} vs {want}");
+    // The gyro g-sensitivity is estimated in every step by default (six positions per
+    // step) and reported per step and as a mean: the preset's G.
+    assert_eq!(v["gyro_g_sensitivity"].as_array().unwrap().len(), 5);
+    let g_true = cfg.gyro.g_sensitivity_rad_s_per_m_s2;
+    for i in 0..3 {
+        for j in 0..3 {
+            let g = v["gyro_g_sensitivity_mean"]["matrix"][i][j]
+                .as_f64()
+                .unwrap();
+            assert!(
+                (g - g_true[i][j]).abs() <= 1e-6 * g_true[0][0],
+                "G_{i}{j} {g} vs {}",
+                g_true[i][j]
+            );
+        }
+    }
     // Order 4 from five temperatures leaves no degree of freedom: refused, named.
     let out = bin()
         .args(["thermal", "soak", "--order", "4", "--manifest"])

@@ -47,10 +47,36 @@
 //!   column k of A from (raw⁺ − raw⁻)/(2ω) (Titterton & Weston §8.3.3); the joint fit
 //!   uses the same information plus the bias.
 //!
-//! The g-sensitivity G (optional, [`SixPositionOptions::estimate_g_sensitivity`]) is
-//! separable from the bias only because each axis is seen both up and down: with f = ±g·e_k
-//! the pair gives b_i ± g·G_ik. With one direction of an axis missing, column k of G and b
-//! are confounded — that input is refused anyway ([`SixPositionError::MissingDirection`]).
+//! # Gyro g-sensitivity
+//!
+//! A MEMS gyro also responds to the specific force it feels (the g-dependent bias of
+//! Groves §4.4; the acceleration-sensitive drift rate of IEEE Std 1431-2004 for Coriolis
+//! vibratory gyros), so the gyro model of every observation is
+//!
+//! ```text
+//! ω_meas,i = Σ_j A_ij·ω_j + b_i + Σ_j G_ij·f_j,      f = g·u   (u: the body axis up)
+//! ```
+//!
+//! G (raw units per m/s²) is estimated with [`SixPositionOptions::estimate_g_sensitivity`]
+//! (3 more parameters per output axis, [`GSensitivityEstimate`] with σ). Everything
+//! observed here is level with a body axis up, so the G terms enter each row only
+//! through its intercept b_i + g·G_i·u.
+//!
+//! **Identifiability.** G is separable from b iff the intercept regressors (1, u) of the
+//! observations span R⁴ — for u among the signed body axes: every axis is seen up or
+//! down, and at least one both ways ([`g_sensitivity_identifiable`]). The static
+//! positions of this calibration (each axis up *and* down, checked:
+//! [`SixPositionError::MissingDirection`]) always satisfy it on their own: the ±k pair
+//! gives b_i ± g·G_ik (plus modelled Earth-rate terms), so column k of G is half their
+//! difference over g. The rate segments alone cannot supply it: all turned with +k up (the
+//! chamber protocol, [`SixPositionInput::from_manifest_columns`]), their intercept is
+//! b_i + g·G_ik. That is also why G must be modelled when the rate segments are all +k
+//! up: left out, the intercepts b_i + g·G_ik of the rate rows pull the least-squares
+//! bias towards them (on `adi-like`, 0.2 °/s/g on the sensing axis, the gyro-z bias of a
+//! soak was off by ≈ 1.9 % of its thermal swing, `tests/thermal_soak.rs`). With rate
+//! segments balanced between +k and −k up the effect would cancel in b, but not in
+//! [`SixPositionOptions::from_manifest`]'s protocols, which is why that constructor turns
+//! G on whenever every step of the manifest identifies it.
 //!
 //! # Covariances
 //!
@@ -161,12 +187,18 @@ pub struct SixPositionOptions {
     pub accel_rail_raw: Option<f64>,
     /// Gyro output rail, raw units.
     pub gyro_rail_raw: Option<f64>,
-    /// Also estimate the gyro g-sensitivity G (9 more parameters).
+    /// Also estimate the gyro g-sensitivity G (9 more parameters; module docs). Needs
+    /// up-directions that identify it ([`g_sensitivity_identifiable`]); the static
+    /// positions this calibration requires always do (an input without them is refused
+    /// with [`SixPositionError::MissingDirection`] first, G or not; the gyro fit also
+    /// refuses unidentifiable directions itself, [`SixPositionError::Invalid`]).
     pub estimate_g_sensitivity: bool,
 }
 
 impl SixPositionOptions {
-    /// Normal gravity and Earth rate at latitude `lat_rad`, height `height_m`.
+    /// Normal gravity and Earth rate at latitude `lat_rad`, height `height_m`; the gyro
+    /// g-sensitivity is not estimated (no protocol is known here; set
+    /// [`SixPositionOptions::estimate_g_sensitivity`] for one that identifies it).
     pub fn at_site(lat_rad: f64, height_m: f64) -> SixPositionOptions {
         SixPositionOptions {
             gravity_m_s2: earth::normal_gravity_m_s2(lat_rad, height_m),
@@ -178,17 +210,53 @@ impl SixPositionOptions {
         }
     }
 
-    /// The site constants of a chamber manifest (its exact gravity and Earth rate).
+    /// The site constants of a chamber manifest (its exact gravity and Earth rate), with
+    /// the gyro g-sensitivity estimated when the manifest identifies it: every
+    /// temperature step ([`ChamberManifest::steps`]) has static positions whose
+    /// up-directions pass [`g_sensitivity_identifiable`] (the six positions do). The
+    /// manifest's rate segments are all turned with +k up, so leaving G out would bias
+    /// the gyro biases (module docs). A manifest that does not identify G in some step
+    /// gets it off; the six-position calibration of that step then names what is
+    /// missing ([`SixPositionError::MissingDirection`]).
     pub fn from_manifest(m: &ChamberManifest) -> SixPositionOptions {
+        let steps = m.steps();
+        let identifiable = !steps.is_empty()
+            && steps.iter().all(|(_, range)| {
+                g_sensitivity_identifiable(m.segments[range.clone()].iter().filter_map(|s| {
+                    match s.kind {
+                        SegmentKind::Position { up } => Some(up),
+                        _ => None,
+                    }
+                }))
+            });
         SixPositionOptions {
             gravity_m_s2: m.gravity_m_s2,
             latitude_rad: m.latitude_deg.to_radians(),
             earth_rate_rad_s: m.earth_rate_rad_s,
             accel_rail_raw: None,
             gyro_rail_raw: None,
-            estimate_g_sensitivity: false,
+            estimate_g_sensitivity: identifiable,
         }
     }
+}
+
+/// Whether observations level with these body axes up identify the gyro g-sensitivity
+/// G beside the bias (module docs): the intercept regressors (1, u) span R⁴, i.e. every
+/// body axis appears (either sign) and at least one appears with both signs. Static
+/// positions alone suffice to test (their A-terms are only the Earth rate); rate
+/// segments add nothing new when turned with +k up.
+pub fn g_sensitivity_identifiable(ups: impl IntoIterator<Item = SignedAxis>) -> bool {
+    // seen[k] = (+k seen, −k seen)
+    let mut seen = [(false, false); 3];
+    for u in ups {
+        let s = &mut seen[u.axis.index()];
+        if u.positive {
+            s.0 = true;
+        } else {
+            s.1 = true;
+        }
+    }
+    seen.iter().all(|s| s.0 || s.1) && seen.iter().any(|s| s.0 && s.1)
 }
 
 /// Why a calibration failed.
@@ -668,6 +736,22 @@ pub fn calibrate_gyro(
     ];
     let w_up = opt.earth_rate_rad_s * opt.latitude_rad.sin();
     let with_g = opt.estimate_g_sensitivity;
+    // Unreachable while every direction is required above, but the G columns must never
+    // reach the solver unidentified.
+    if with_g
+        && !g_sensitivity_identifiable(
+            positions
+                .iter()
+                .map(|p| p.up)
+                .chain(rates.iter().map(|r| r.up)),
+        )
+    {
+        return Err(SixPositionError::Invalid(
+            "the gyro g-sensitivity is not identifiable from these up-directions (needs every \
+             axis up or down and one both ways); turn estimate_g_sensitivity off"
+                .into(),
+        ));
+    }
     let n = if with_g { 7 } else { 4 };
     let mut fits = Vec::with_capacity(3);
     for i in 0..3 {

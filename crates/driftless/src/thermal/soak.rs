@@ -12,6 +12,20 @@
 //! σ(A_kk) is propagated from the covariance of M = A⁻¹ reported by the calibration:
 //! dA = −A·dM·A, so ∂A_kk/∂M_ij = −A_ki·A_jk.
 //!
+//! # Gyro g-sensitivity
+//!
+//! The rate-table segments of a chamber step are all turned with +k up, so the gyro's
+//! g-sensitivity, ω_meas = A·ω + b + G·f with f = g·u in every level observation, adds
+//! g·G_ik to each rate row of output axis i; unmodelled, it offsets the gyro bias series
+//! (≈ 1.9 % of the gyro-z swing on `adi-like`). The six-position fit of each step estimates
+//! G when [`SixPositionOptions::estimate_g_sensitivity`] is set —
+//! [`SixPositionOptions::from_manifest`] sets it whenever every step's static positions
+//! identify G (each axis up and down; [`crate::calib::six_position`] module docs) — and
+//! the result reports it per step ([`SoakCalibration::gyro_g_sensitivity`], with σ) and
+//! as an inverse-variance mean ([`SoakCalibration::gyro_g_sensitivity_mean`]). It is not
+//! part of the compensation model (which has no G term); the bias series are the
+//! zero-g biases b_k(T).
+//!
 //! The temperature of each point is the set temperature (the protocol soaks until the
 //! sensor has settled; the manifest's soak is sized for that).
 //!
@@ -55,9 +69,11 @@
 
 use super::fit::{FitOptions, ThermalFit, ThermalFitError, fit, fit_correlated};
 use crate::calib::six_position::{
-    SixPositionError, SixPositionInput, SixPositionOptions, TriadEstimate, calibrate,
+    GSensitivityEstimate, SixPositionError, SixPositionInput, SixPositionOptions, TriadEstimate,
+    calibrate,
 };
 use crate::sim::chamber_manifest::{ChamberManifest, SegmentKind};
+use driftless_model::linalg::Mat3;
 
 /// Why a soak calibration failed.
 #[derive(Debug, thiserror::Error)]
@@ -206,6 +222,10 @@ pub struct SoakCalibration {
     pub temperatures_c: Vec<f64>,
     /// The six-position estimates (accelerometer, gyro) of each step.
     pub estimates: Vec<(TriadEstimate, TriadEstimate)>,
+    /// The gyro g-sensitivity G of each step (raw gyro units per m/s², with σ), in the
+    /// order of `temperatures_c`; `None` where it was not estimated
+    /// ([`SixPositionOptions::estimate_g_sensitivity`] off).
+    pub gyro_g_sensitivity: Vec<Option<GSensitivityEstimate>>,
     /// 12 series: accel bias x/y/z, accel scale x/y/z, gyro bias x/y/z, gyro scale x/y/z.
     pub series: Vec<SeriesFit>,
 }
@@ -299,6 +319,44 @@ impl SoakCalibration {
         .map_err(invalid)
     }
 
+    /// Inverse-variance weighted mean of the per-step g-sensitivity, entry by entry:
+    /// Ḡ_ij = Σ_s G_ij(s)/σ_ij(s)² / Σ_s 1/σ_ij(s)², σ(Ḡ_ij) = (Σ_s 1/σ_ij(s)²)^(−½) —
+    /// treating G as independent of temperature and the steps' errors as independent.
+    /// `None` unless every step estimated G with σ > 0 (noise-free data gives σ = 0:
+    /// then the plain mean, σ 0).
+    pub fn gyro_g_sensitivity_mean(&self) -> Option<GSensitivityEstimate> {
+        let steps: Vec<&GSensitivityEstimate> = self
+            .gyro_g_sensitivity
+            .iter()
+            .map(Option::as_ref)
+            .collect::<Option<Vec<_>>>()?;
+        if steps.is_empty() {
+            return None;
+        }
+        // (mean, σ) of entry (i, j)
+        let entry = |i: usize, j: usize| -> (f64, f64) {
+            let weighted = steps.iter().all(|g| g.sigma_raw_per_m_s2[i][j] > 0.0);
+            let (mut sw, mut swx) = (0.0, 0.0);
+            for g in &steps {
+                let w = if weighted {
+                    g.sigma_raw_per_m_s2[i][j].powi(-2)
+                } else {
+                    1.0
+                };
+                sw += w;
+                swx += w * g.matrix_raw_per_m_s2.0[i][j];
+            }
+            (swx / sw, if weighted { sw.powf(-0.5) } else { 0.0 })
+        };
+        let e: [[(f64, f64); 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| entry(i, j)));
+        let mean = Mat3(e.map(|r| r.map(|x| x.0)));
+        let sigma = e.map(|r| r.map(|x| x.1));
+        Some(GSensitivityEstimate {
+            matrix_raw_per_m_s2: mean,
+            sigma_raw_per_m_s2: sigma,
+        })
+    }
+
     /// The series of `triad` / `quantity` / `axis`.
     pub fn get(&self, triad: &str, quantity: &str, axis: usize) -> Option<&SeriesFit> {
         self.series
@@ -325,7 +383,9 @@ fn scale_sigma(est: &TriadEstimate) -> [f64; 3] {
 
 /// Six-position calibration at every temperature step of `manifest`
 /// ([`ChamberManifest::steps`]; sample columns as for
-/// [`SixPositionInput::from_manifest_columns`]), then a polynomial fit of every bias and
+/// [`SixPositionInput::from_manifest_columns`]; with the gyro g-sensitivity when `six`
+/// asks for it — [`SixPositionOptions::from_manifest`] does whenever the manifest
+/// identifies it, module docs), then a polynomial fit of every bias and
 /// scale series weighted by its standard errors — with `drift`, the bias series by
 /// generalised least squares with the drift covariance (module docs).
 pub fn soak_calibration(
@@ -352,6 +412,7 @@ pub fn soak_calibration(
     }
     // per step: (accel, gyro) estimates
     let mut ests = Vec::with_capacity(temps.len());
+    let mut g_sens = Vec::with_capacity(temps.len());
     for (t, range) in &steps {
         let t = *t;
         let step = manifest.step_manifest(range.clone());
@@ -360,6 +421,7 @@ pub fn soak_calibration(
         let cal =
             calibrate(&input, six).map_err(|source| SoakError::Calibration { t_c: t, source })?;
         ests.push((cal.accel, cal.gyro));
+        g_sens.push(cal.gyro_g_sensitivity);
     }
     // Per step: mid-time and total duration of its static positions.
     let (mut times, mut average_s) = (Vec::with_capacity(temps.len()), f64::INFINITY);
@@ -431,6 +493,7 @@ pub fn soak_calibration(
     Ok(SoakCalibration {
         temperatures_c: temps,
         estimates: ests,
+        gyro_g_sensitivity: g_sens,
         series,
     })
 }
