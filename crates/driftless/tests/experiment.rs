@@ -3,8 +3,8 @@
 //! * `builtin_monte_carlo_thermal_model_pays`: the built-in `adi-like` scenario (the demo)
 //!   over 20 Monte Carlo runs — case (c) room + thermal has a lower mean 60-s outage
 //!   error than case (b) room calibration only, and the 95 % bootstrap interval of the
-//!   ratio (b)/(c) lies above 1. Measured (2 cores): ratio 2.01× (1.83–2.26×); per-run
-//!   means (b) 416 m, (c) 207 m; no run fails. The paper: 8.4× (1254 m / 150 m) — the
+//!   ratio (b)/(c) lies above 1. Measured (2 cores): ratio 2.05× (1.84–2.33×); mean of
+//!   the per-run means (a) 426 m, (b) 421 m, (c) 205 m; no run fails. The paper: 8.4× (1254 m / 150 m) — the
 //!   report explains the difference; the scenario was not tuned towards it.
 //! * wrong scenarios fail in [`prepare`] (before the noise stage, i.e. before any long
 //!   computation) with a message naming the problem;
