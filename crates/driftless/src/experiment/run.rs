@@ -73,10 +73,111 @@ pub type Progress<'a> = &'a (dyn Fn(&str, u64, u64) + Sync);
 pub struct RecordedVehicle {
     /// The IMU stream (vehicle frame).
     pub imu: ImuStream,
+    /// The rates log with its temperature column (`csv` format only): cases b and c
+    /// compensate it sample by sample.
+    pub rates: Option<RatesWithTemperature>,
     /// GNSS fixes inside the IMU span.
     pub fixes: GnssFixes,
     /// Session settings (filter, aids, floors) of the data set.
     pub session: SessionConfig,
+}
+
+/// A rates log split into SI triads and the temperature reading (`csv` vehicle data).
+#[derive(Clone, Debug)]
+pub struct RatesWithTemperature {
+    /// Where it came from.
+    pub source: String,
+    /// Time stamps, GPS s.
+    pub time_s: Vec<f64>,
+    /// Angular rate x, y, z, rad/s.
+    pub gyro_rad_s: [Vec<f64>; 3],
+    /// Specific force x, y, z, m/s².
+    pub accel_m_s2: [Vec<f64>; 3],
+    /// Sensor temperature, °C (`None` without a temperature column).
+    pub temperature_c: Option<Vec<f64>>,
+}
+
+impl RatesWithTemperature {
+    /// Splits a log: the first three angular-rate and specific-force channels in file
+    /// order, and the temperature channel if there is one.
+    pub fn from_log(log: &ImuLog) -> Result<RatesWithTemperature, String> {
+        let Some(t) = &log.time_s else {
+            return Err(format!("{}: no time column", log.source));
+        };
+        let pick = |q: Quantity, what: &str| -> Result<[Vec<f64>; 3], String> {
+            let idx = log.indices_of(q);
+            if idx.len() != 3 {
+                return Err(format!(
+                    "{}: {} {what} columns found, 3 needed (name the units in the header, e.g. \
+                     gyro_x [rad/s], acc_x [m/s^2])",
+                    log.source,
+                    idx.len()
+                ));
+            }
+            Ok([0, 1, 2].map(|k| log.channels[idx[k]].values.clone()))
+        };
+        let temperature_c = log
+            .indices_of(Quantity::Temperature)
+            .first()
+            .map(|&i| log.channels[i].values.clone());
+        Ok(RatesWithTemperature {
+            source: log.source.clone(),
+            time_s: t.clone(),
+            gyro_rad_s: pick(Quantity::AngularRate, "angular-rate")?,
+            accel_m_s2: pick(Quantity::SpecificForce, "specific-force")?,
+            temperature_c,
+        })
+    }
+
+    /// The stream after `f(sample index, ω, f) → (ω', f')`.
+    fn stream(
+        &self,
+        label: &str,
+        f: impl Fn(usize, [f64; 3], [f64; 3]) -> Result<([f64; 3], [f64; 3]), String>,
+    ) -> Result<ImuStream, String> {
+        let n = self.time_s.len();
+        let mut g: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(n));
+        let mut a: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(n));
+        for k in 0..n {
+            let w = [0, 1, 2].map(|j| self.gyro_rad_s[j][k]);
+            let fb = [0, 1, 2].map(|j| self.accel_m_s2[j][k]);
+            let (wc, fc) = f(k, w, fb)?;
+            for j in 0..3 {
+                g[j].push(wc[j]);
+                a[j].push(fc[j]);
+            }
+        }
+        let mut channels = Vec::with_capacity(6);
+        for (j, v) in g.into_iter().enumerate() {
+            channels.push(crate::io::Channel {
+                name: format!("gyro_{}", ["x", "y", "z"][j]),
+                quantity: Quantity::AngularRate,
+                source_unit: "rad/s".into(),
+                values: v,
+            });
+        }
+        for (j, v) in a.into_iter().enumerate() {
+            channels.push(crate::io::Channel {
+                name: format!("acc_{}", ["x", "y", "z"][j]),
+                quantity: Quantity::SpecificForce,
+                source_unit: "m/s^2".into(),
+                values: v,
+            });
+        }
+        let tau0 = crate::eval::reference::median_interval_s(&self.time_s);
+        let log = ImuLog::new(
+            format!("{} ({label})", self.source),
+            Some(self.time_s.clone()),
+            tau0,
+            channels,
+        );
+        crate::nav::pipeline::imu_from_rates_log(
+            &log,
+            &crate::nav::pipeline::RateChannels::ByQuantity,
+            &ImuStreamOptions::default(),
+        )
+        .map_err(|e| e.to_string())
+    }
 }
 
 /// The checked experiment, ready to run.
@@ -200,14 +301,35 @@ pub fn prepare(scenario: ExperimentScenario) -> Result<Prepared, ExperimentError
                 recorded: None,
             })
         }
-        VehicleSource::Drive0708 | VehicleSource::KfGins => {
+        VehicleSource::Drive0708 | VehicleSource::KfGins | VehicleSource::Csv => {
             let v = &scenario.vehicle;
             let (Some(imu_rel), Some(gnss_rel)) = (&v.imu_file, &v.gnss_file) else {
                 return Err(scenario.invalid("recorded [vehicle] needs imu_file and gnss_file"));
             };
             let (imu_path, gnss_path) = (scenario.resolve(imu_rel), scenario.resolve(gnss_rel));
             let stage = |e: &dyn std::fmt::Display| ExperimentError::stage("vehicle", e);
-            let (imu, mut session) = if source == VehicleSource::Drive0708 {
+            let mut rates = None;
+            let (imu, mut session) = if source == VehicleSource::Csv {
+                let opts = crate::io::TextOptions {
+                    time_column: Some(crate::io::text::ColumnRef::Index(1)),
+                    ..crate::io::TextOptions::default()
+                };
+                let log = crate::io::read_log_file(&imu_path, &opts).map_err(|e| stage(&e))?;
+                let r = RatesWithTemperature::from_log(&log).map_err(|e| stage(&e))?;
+                if scenario.chamber.is_some() && r.temperature_c.is_none() {
+                    return Err(scenario.invalid(format!(
+                        "[chamber] model given, but {} has no temperature column (a header \
+                         field with unit [degC] or named temperature)",
+                        imu_path.display()
+                    )));
+                }
+                let imu = r
+                    .stream("raw", |_, w, f| Ok((w, f)))
+                    .map_err(|e| stage(&e))?;
+                rates = Some(r);
+                let noise = crate::nav::session::consumer_mems_noise();
+                (imu, SessionConfig::new(FilterConfig::new(noise, [0.0; 3])))
+            } else if source == VehicleSource::Drive0708 {
                 let mut tag = imu_path.clone().into_os_string();
                 tag.push(".tag");
                 let imu = imu_from_tagged_csv_files(
@@ -248,6 +370,7 @@ pub fn prepare(scenario: ExperimentScenario) -> Result<Prepared, ExperimentError
                 outages,
                 recorded: Some(RecordedVehicle {
                     imu,
+                    rates,
                     fixes,
                     session,
                 }),
@@ -464,7 +587,8 @@ pub fn thermal_stage(
     )
     .map_err(|e| err(&e))?;
     let model = soak
-        .compensation_model(run_seed(sc.seed, TAG_CHAMBER, run), OutOfRange::Clamp)
+        // Model id < 2⁶³: the model file stores it as a (signed 64-bit) TOML integer.
+        .compensation_model(run_seed(sc.seed, TAG_CHAMBER, run) >> 1, OutOfRange::Clamp)
         .map_err(|e| err(&e))?;
     Ok(Some(ThermalStage {
         model,
@@ -761,6 +885,9 @@ pub fn vehicle_run(
             if let Some(n) = noise {
                 session.filter.imu = filter_noise(sc, &n.model)?;
             }
+            if sc.filter.nhc {
+                session.filter.nhc = Some(NhcConfig::default());
+            }
             session.smooth = smooth_this;
             // Reference: case (b)'s smoothed solution with every fix.
             let reference = {
@@ -775,23 +902,65 @@ pub fn vehicle_run(
                     .map_err(|e| ExperimentError::stage("reference", e))?;
                 from_nav_states(sm.epochs.iter().map(|e| &e.nav))
             };
-            let results: Vec<CaseRun> = [Case::Raw, Case::Room]
+            let mut cases = vec![Case::Raw, Case::Room];
+            if thermal.is_some() {
+                cases.push(Case::Thermal);
+            }
+            let results: Vec<CaseRun> = cases
                 .par_iter()
                 .map(|&case| {
+                    // With a thermal model (csv data with temperature): (b) its room
+                    // calibration, (c) the whole model; without: (b) removes the
+                    // static-start gyro bias.
+                    let stream = match (case, thermal, &rec.rates) {
+                        (Case::Room, Some(t), Some(r)) => {
+                            let room = *t.model.calibration();
+                            r.stream("room calibration", |_, w, f| {
+                                Ok((room.gyro.apply(w), room.accel.apply(f)))
+                            })
+                        }
+                        (Case::Thermal, Some(t), Some(r)) => match &r.temperature_c {
+                            Some(temp) => r.stream("room + thermal", |k, w, f| {
+                                t.model
+                                    .compensate(w, f, temp[k])
+                                    .map_err(|e| format!("sample {k}: {e}"))
+                            }),
+                            None => Err("no temperature column".to_string()),
+                        },
+                        _ => Ok(rec.imu.clone()),
+                    };
+                    let imu = match stream {
+                        Ok(s) => s,
+                        Err(e) => {
+                            return CaseRun {
+                                case,
+                                forward: Err(format!("compensation: {e}")),
+                                smoothed: None,
+                                gnss_accepted: 0,
+                                gnss_rejected: 0,
+                                forward_solution: None,
+                            };
+                        }
+                    };
                     let input = CaseInput {
                         case,
-                        imu: rec.imu.clone(),
+                        imu,
                         fixes: &rec.fixes,
                         session: session.clone(),
-                        prime: case == Case::Room,
+                        prime: case == Case::Room && thermal.is_none(),
                     };
                     run_case(input, sc, &windows, &reference, detail)
                 })
                 .collect();
+            let temperature_c = rec
+                .rates
+                .as_ref()
+                .and_then(|r| r.temperature_c.as_ref())
+                .and_then(|t| t.first().zip(t.last()).map(|(a, b)| (*a, *b)));
             Ok(VehicleRun {
                 run,
                 cases: results,
-                temperature_c: None,
+                temperature_c,
                 reference: detail.then_some(reference),
                 fixes: detail.then(|| rec.fixes.clone()),
             })

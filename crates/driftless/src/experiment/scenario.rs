@@ -161,7 +161,10 @@ pub struct VehicleSpec {
     /// Recorded GNSS file (RTKLIB `.pos` or KF-GINS text).
     #[serde(default)]
     pub gnss_file: Option<PathBuf>,
-    /// Recorded data format: `drive_0708` (tagged CSV + the drive's settings) or `kf-gins`.
+    /// Recorded data format: `drive_0708` (tagged CSV + the drive's settings), `kf-gins`
+    /// (increments), or `csv` (delimited text of rates with a header naming units, the
+    /// time in GPS seconds in the first column, and optionally a temperature column — the
+    /// format `driftless simulate` writes — which allows case c with `[chamber] model`).
     #[serde(default)]
     pub format: Option<String>,
     /// IMU → antenna lever arm, body FRD, m (recorded data; simulated data use the gnss one).
@@ -291,6 +294,8 @@ pub enum VehicleSource {
     Drive0708,
     /// KF-GINS increment text.
     KfGins,
+    /// Delimited text of rates (and temperature), first column GPS time.
+    Csv,
 }
 
 impl ExperimentScenario {
@@ -404,11 +409,13 @@ impl ExperimentScenario {
             (false, true) => match v.format.as_deref() {
                 Some("drive_0708") => Ok(VehicleSource::Drive0708),
                 Some("kf-gins") => Ok(VehicleSource::KfGins),
+                Some("csv") => Ok(VehicleSource::Csv),
                 Some(other) => Err(self.invalid(format!(
-                    "vehicle.format = {other:?}: expected \"drive_0708\" or \"kf-gins\""
+                    "vehicle.format = {other:?}: expected \"drive_0708\", \"kf-gins\" or \"csv\""
                 ))),
                 None => Err(self.invalid(
-                    "vehicle.format is needed with recorded files: \"drive_0708\" or \"kf-gins\"",
+                    "vehicle.format is needed with recorded files: \"drive_0708\", \"kf-gins\" \
+                     or \"csv\"",
                 )),
             },
         }
@@ -522,7 +529,7 @@ impl ExperimentScenario {
                     )));
                 }
             }
-            VehicleSource::Drive0708 | VehicleSource::KfGins => {
+            VehicleSource::Drive0708 | VehicleSource::KfGins | VehicleSource::Csv => {
                 let v = &self.vehicle;
                 let (Some(i), Some(g)) = (&v.imu_file, &v.gnss_file) else {
                     return Err(self.invalid("recorded [vehicle] needs imu_file and gnss_file"));
@@ -546,12 +553,23 @@ impl ExperimentScenario {
                         self.monte_carlo.runs
                     )));
                 }
-                if self.chamber.is_some() {
-                    return Err(self.invalid(
-                        "[chamber] with recorded vehicle data: the recorded formats \
-                         (drive_0708, kf-gins) carry no sensor temperature, so a thermal \
-                         model cannot be applied (case c); drop [chamber] to run cases a and b",
-                    ));
+                match (&self.chamber, source) {
+                    (Some(c), VehicleSource::Csv) if c.protocol.is_some() => {
+                        return Err(self.invalid(
+                            "[chamber.protocol] simulates a sensor, but the vehicle data are \
+                             recorded: give chamber.model, the thermal model of this IMU \
+                             (`driftless thermal soak --out`)",
+                        ));
+                    }
+                    (Some(_), VehicleSource::Drive0708 | VehicleSource::KfGins) => {
+                        return Err(self.invalid(
+                            "[chamber] with recorded vehicle data: the drive_0708 and kf-gins \
+                             formats carry no sensor temperature, so a thermal model cannot be \
+                             applied (case c); drop [chamber], or give the IMU as format = \
+                             \"csv\" with a temperature column",
+                        ));
+                    }
+                    _ => {}
                 }
             }
         }
