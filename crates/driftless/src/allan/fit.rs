@@ -7,7 +7,7 @@
 //! σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + R²τ²/2  [+ σ_GM²·g(τ/T)]
 //! ```
 //!
-//! All values SI: data units u (rad/s or m/s²) → Q [u·s], N [u·√s], B [u], K [u/√s], R [u/s].
+//! All values SI: data units u (rad/s or m/s²) → Q \[u·s], N \[u·√s], B \[u], K \[u/√s], R \[u/s].
 //!
 //! # Method
 //!

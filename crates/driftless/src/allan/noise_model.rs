@@ -12,8 +12,8 @@
 //!
 //! | term | continuous (SI) | discrete, per sample at f_s |
 //! |------|-----------------|-----------------------------|
-//! | white N | density N [u·√s], two-sided PSD N² [u²/Hz] | σ_d = N·√f_s [u] (std of each rate sample) |
-//! | rate random walk K | density K [u/√s], PSD of the bias derivative K² [u²/s] | σ_Δb = K·√Δt [u] (std of the bias change per step) |
+//! | white N | density N \[u·√s], two-sided PSD N² \[u²/Hz] | σ_d = N·√f_s \[u] (std of each rate sample) |
+//! | rate random walk K | density K \[u/√s], PSD of the bias derivative K² \[u²/s] | σ_Δb = K·√Δt \[u] (std of the bias change per step) |
 //! | bias instability B | flicker floor, ADEV ≈ 0.664·B | no exact finite-state form; a first-order Gauss-Markov (σ_b, T_c) whose Allan-variance peak equals the floor at the floor's τ: φ = e^{−Δt/T_c}, σ_w = σ_b·√(1−φ²) |
 //! | quantization Q | angle/velocity noise [u·s] | std Q of each integrated (angle/velocity) sample |
 //! | rate ramp R | [u/s] | R·Δt per sample (deterministic) |

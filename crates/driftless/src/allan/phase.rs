@@ -10,7 +10,7 @@
 /// Returns `y.len() + 1` points (empty input gives `[0.0]`).
 ///
 /// The running sum is Kahan-compensated. To break its serial dependency chain the series
-/// is cut into [`LANES`] consecutive pieces whose compensated sums advance together in one
+/// is cut into `LANES` consecutive pieces whose compensated sums advance together in one
 /// loop; each piece is then shifted by the compensated total of the pieces before it.
 pub fn frequency_to_phase(y: &[f64], tau0: f64) -> Vec<f64> {
     let n = y.len();

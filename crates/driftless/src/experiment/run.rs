@@ -614,6 +614,18 @@ pub struct CaseRun {
 }
 
 impl CaseRun {
+    /// A case whose processing failed before or in the filter.
+    pub fn failed(case: Case, message: String) -> CaseRun {
+        CaseRun {
+            case,
+            forward: Err(message),
+            smoothed: None,
+            gnss_accepted: 0,
+            gnss_rejected: 0,
+            forward_solution: None,
+        }
+    }
+
     /// Mean end-of-outage horizontal error of the forward filter, m (`None` if it failed).
     pub fn forward_mean_end_m(&self) -> Option<f64> {
         mean_end(&self.forward)
@@ -726,14 +738,7 @@ fn run_case(
     session.outages = windows.to_vec();
     let mut fcfg = session.filter.clone();
     fcfg.outages_s = windows.iter().map(|w| (w.start_s, w.end_s)).collect();
-    let failed = |case, msg: String| CaseRun {
-        case,
-        forward: Err(msg),
-        smoothed: None,
-        gnss_accepted: 0,
-        gnss_rejected: 0,
-        forward_solution: None,
-    };
+    let failed = CaseRun::failed;
     let primed = if input.prime {
         prime_gyro_bias(&input.imu, session.static_prime_s.max(1.0))
     } else {
@@ -850,14 +855,7 @@ pub fn vehicle_run(
                     let out = match compensate(&sim.imu, case, thermal) {
                         Ok(o) => o,
                         Err(e) => {
-                            return CaseRun {
-                                case,
-                                forward: Err(format!("compensation: {e}")),
-                                smoothed: None,
-                                gnss_accepted: 0,
-                                gnss_rejected: 0,
-                                forward_solution: None,
-                            };
+                            return CaseRun::failed(case, format!("compensation: {e}"));
                         }
                     };
                     let input = CaseInput {
@@ -932,14 +930,7 @@ pub fn vehicle_run(
                     let imu = match stream {
                         Ok(s) => s,
                         Err(e) => {
-                            return CaseRun {
-                                case,
-                                forward: Err(format!("compensation: {e}")),
-                                smoothed: None,
-                                gnss_accepted: 0,
-                                gnss_rejected: 0,
-                                forward_solution: None,
-                            };
+                            return CaseRun::failed(case, format!("compensation: {e}"));
                         }
                     };
                     let input = CaseInput {

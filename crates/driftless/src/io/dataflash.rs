@@ -18,8 +18,8 @@
 //! | `c` `C` | int16, uint16 | × 0.01 |
 //! | `e` `E` | int32, uint32 | × 0.01 |
 //! | `L` | int32 latitude/longitude | × 1e-7 (degrees) |
-//! | `n` `N` `Z` | char[4], char[16], char[64] | text |
-//! | `a` | int16[32] | array (not decoded as a column) |
+//! | `n` `N` `Z` | `char[4]`, `char[16]`, `char[64]` | text |
+//! | `a` | `int16[32]` | array (not decoded as a column) |
 //!
 //! FMTU / UNIT / MULT messages are read like any other type (they only annotate units).
 //!
@@ -62,7 +62,7 @@ pub enum DfKind {
     Number(Scalar, f64),
     /// A NUL-padded string of this many bytes (`n N Z`).
     Text(usize),
-    /// `a`: int16[32].
+    /// `a`: `int16[32]`.
     Array,
 }
 

@@ -3,7 +3,7 @@
 //!
 //! * [`text`]: delimited text (CSV, whitespace, tab, semicolon), streamed and parsed in parallel.
 //! * [`binary`]: the compact `DRIFTLOG` column-major binary format (reader and writer).
-//! * [`write`]: CSV writer.
+//! * [`write`](mod@write): CSV writer.
 //! * [`ulog`], [`dataflash`], [`autopilot`] (feature `autopilot-logs`, on by default): PX4
 //!   ULog and ArduPilot DataFlash logs → one [`log::ImuLog`] per IMU instance.
 //! * [`units`]: unit strings → SI conversion.

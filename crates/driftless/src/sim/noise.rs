@@ -7,7 +7,7 @@
 //! σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + R²τ²/2  [+ Gauss-Markov]
 //! ```
 //!
-//! All parameters are SI, continuous-time: Q [u·s], N [u·√s], B [u], K [u/√s], R [u/s].
+//! All parameters are SI, continuous-time: Q \[u·s], N \[u·√s], B \[u], K \[u/√s], R \[u/s].
 //! IEEE 952 writes the rate PSDs two-sided (σ²(τ) = 4∫₀^∞ S(f) sin⁴(πfτ)/(πfτ)² df);
 //! the same convention is used below.
 //!
@@ -103,7 +103,7 @@ pub enum SimError {
     },
 }
 
-/// First-order Gauss-Markov process parameters (stationary σ [u], correlation time T [s]).
+/// First-order Gauss-Markov process parameters (stationary σ \[u], correlation time T \[s]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GaussMarkovConfig {
     /// Stationary standard deviation, u.

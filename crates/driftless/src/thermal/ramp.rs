@@ -14,7 +14,7 @@
 //!   `slope_window_s`); when both directions cover common bins the RMS difference of
 //!   their bin medians there is reported as the hysteresis, per channel.
 //!
-//! The points of both directions are then fitted per channel by [`super::fit`]. The
+//! The points of both directions are then fitted per channel by [`super::fit`](mod@super::fit). The
 //! fitted "bias" of a static sensor includes the constant part of what it senses (Earth
 //! rate, gravity along the axis) and, on an axis that senses gravity, the thermal scale
 //! factor times g — as in the autopilots' ramp calibrations; [`ThermalFit`] values are

@@ -2,7 +2,7 @@
 //! a chamber recording, a six-position + rate-table calibration
 //! ([`crate::calib::six_position`]) gives each axis's bias b_k(T) and scale factor
 //! A_kk(T) with their standard errors; each series is then fitted by a polynomial in
-//! T − T_ref ([`super::fit`]), weighted by those errors.
+//! T − T_ref ([`super::fit`](mod@super::fit)), weighted by those errors.
 //!
 //! Quantities per axis k, from the forward model raw = A·x + b of each temperature:
 //! * bias b_k(T), raw units;

@@ -1,7 +1,7 @@
 //! Land-vehicle aids: the non-holonomic constraint (NHC) and zero-velocity /
 //! zero-angular-rate updates (ZUPT / ZARU) with automatic standstill detection.
 //!
-//! Each aid is optional ([`FilterConfig::nhc`], [`FilterConfig::standstill`], both `None`
+//! Each aid is optional ([`FilterConfig::nhc`](super::model::FilterConfig::nhc), [`FilterConfig::standstill`](super::model::FilterConfig::standstill), both `None`
 //! by default) and is applied by [`super::run_forward`] after the prediction of a whole
 //! IMU epoch; the measurement models are in [`super::Eskf::update_nhc`],
 //! [`super::Eskf::update_zupt`] and [`super::Eskf::update_zaru`].
