@@ -294,3 +294,48 @@ fn recorded_csv_with_temperature_runs_all_three_cases() {
     assert!(e.contains("no temperature column"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `[noise] file`: the static log as a CSV file gives the same noise model as the
+/// simulated log in memory (the CSV round trip is exact: shortest round-trip decimals).
+#[test]
+fn noise_stage_from_a_static_log_file_matches_the_in_memory_log() {
+    use driftless::experiment::run::{noise_stage, simulated_static_log};
+    let dir = std::env::temp_dir().join(format!("driftless-exp-noise-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let text = BUILTIN_ADI_LIKE.replace("hours = 2.0", "hours = 0.5");
+    let p = prepare(
+        ExperimentScenario::from_toml_str(&text, "half-hour", PathBuf::new()).expect("scenario"),
+    )
+    .expect("prepare");
+    let a = noise_stage(&p).expect("noise").expect("some");
+    let log = simulated_static_log(&p).expect("log");
+    driftless::io::write_csv_file(&log, dir.join("static.csv")).expect("csv");
+    let text = text.replace("hours = 0.5", "file = \"static.csv\"");
+    let p =
+        prepare(ExperimentScenario::from_toml_str(&text, "file", dir.clone()).expect("scenario"))
+            .expect("prepare");
+    let b = noise_stage(&p).expect("noise from file").expect("some");
+    assert_eq!(a.model.channels.len(), 6);
+    assert_eq!(b.model.channels.len(), 6);
+    for (x, y) in a.model.channels.iter().zip(&b.model.channels) {
+        assert_eq!(x.quantity, y.quantity);
+        let (fx, fy) = (&x.fit, &y.fit);
+        for (tx, ty) in [
+            (fx.white, fy.white),
+            (fx.bias_instability, fy.bias_instability),
+            (fx.rate_random_walk, fy.rate_random_walk),
+        ] {
+            match (tx, ty) {
+                (Some(u), Some(v)) => {
+                    assert!(
+                        (u.value - v.value).abs() <= 1e-9 * u.value.abs(),
+                        "{u:?} vs {v:?}"
+                    )
+                }
+                (None, None) => {}
+                other => panic!("{}: {other:?}", x.name),
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -473,6 +473,39 @@ pub fn analyse_static_log(log: &ImuLog) -> Result<NoiseStage, ExperimentError> {
     })
 }
 
+/// The static log the noise stage simulates for `[noise] hours` (sensor `[sensor]` at
+/// rest, level, at the chamber site; every error term; the noise seed of the scenario).
+pub fn simulated_static_log(p: &Prepared) -> Result<ImuLog, ExperimentError> {
+    let sc = &p.scenario;
+    let (Some(sensor), Some(spec), Some(h)) = (
+        &p.sensor,
+        &sc.sensor,
+        sc.noise.as_ref().and_then(|n| n.hours),
+    ) else {
+        return Err(sc.invalid("[noise] hours needs [sensor]"));
+    };
+    let traj = TrajectorySpec::Static {
+        lat_deg: 51.08,
+        lon_deg: -114.13,
+        height_m: 1100.0,
+        roll_deg: 0.0,
+        pitch_deg: 0.0,
+        yaw_deg: 0.0,
+        duration_s: h * 3600.0,
+    };
+    let sim = sim_scenario(
+        sc,
+        sensor,
+        spec.rate_hz,
+        traj,
+        run_seed(sc.seed, TAG_NOISE, 0),
+        ErrorTerms::All,
+    )
+    .run()
+    .map_err(|e| ExperimentError::stage("noise", e))?;
+    Ok(sim.rates_log(&format!("simulated {h} h static log")))
+}
+
 /// The noise stage: simulate a static log of the sensor and analyse it, analyse a given
 /// log, or read a saved model. `None` for a recorded scenario without `[noise]` (the
 /// data set's own noise settings are used).
@@ -481,35 +514,21 @@ pub fn noise_stage(p: &Prepared) -> Result<Option<NoiseStage>, ExperimentError> 
     let Some(n) = &sc.noise else {
         return Ok(None);
     };
-    if let Some(h) = n.hours {
-        let (Some(sensor), Some(spec)) = (&p.sensor, &sc.sensor) else {
-            return Err(sc.invalid("[noise] hours needs [sensor]"));
-        };
-        let traj = TrajectorySpec::Static {
-            lat_deg: 51.08,
-            lon_deg: -114.13,
-            height_m: 1100.0,
-            roll_deg: 0.0,
-            pitch_deg: 0.0,
-            yaw_deg: 0.0,
-            duration_s: h * 3600.0,
-        };
-        let sim = sim_scenario(
-            sc,
-            sensor,
-            spec.rate_hz,
-            traj,
-            run_seed(sc.seed, TAG_NOISE, 0),
-            ErrorTerms::All,
-        )
-        .run()
-        .map_err(|e| ExperimentError::stage("noise", e))?;
-        let log = sim.rates_log(&format!("simulated {h} h static log"));
+    if n.hours.is_some() {
+        let log = simulated_static_log(p)?;
         return analyse_static_log(&log).map(Some);
     }
     if let Some(f) = &n.file {
         let path = sc.resolve(f);
-        let log = crate::io::read_log_file(&path, &crate::io::TextOptions::default())
+        let opts = crate::io::TextOptions {
+            time_column: n
+                .rate_hz
+                .is_none()
+                .then_some(crate::io::text::ColumnRef::Index(1)),
+            rate_hz: n.rate_hz,
+            ..crate::io::TextOptions::default()
+        };
+        let log = crate::io::read_log_file(&path, &opts)
             .map_err(|e| ExperimentError::stage("noise", e))?;
         return analyse_static_log(&log).map(Some);
     }

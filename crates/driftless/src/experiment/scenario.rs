@@ -114,9 +114,14 @@ pub struct NoiseSpec {
     /// Length of a simulated static log of `[sensor]`, h.
     #[serde(default)]
     pub hours: Option<f64>,
-    /// A static log to analyse (any format `driftless allan` reads, default options).
+    /// A static log to analyse: DRIFTLOG, or delimited text with units in its header
+    /// (`gyro_x [deg/s]`) and the time in its first column — or no time column and
+    /// `rate_hz`.
     #[serde(default)]
     pub file: Option<PathBuf>,
+    /// Sample rate of a `file` without a time column, Hz.
+    #[serde(default)]
+    pub rate_hz: Option<f64>,
     /// A saved noise model (`driftless allan --save-model`).
     #[serde(default)]
     pub model: Option<PathBuf>,
@@ -459,6 +464,14 @@ impl ExperimentScenario {
             }
             if let Some(f) = &n.file {
                 self.existing("noise.file", f)?;
+            }
+            if let Some(r) = n.rate_hz
+                && (n.file.is_none() || !(r.is_finite() && r > 0.0))
+            {
+                return Err(self.invalid(format!(
+                    "noise.rate_hz = {r}: a positive rate, only with noise.file (a log without \
+                     a time column)"
+                )));
             }
             if let Some(f) = &n.model {
                 self.existing("noise.model", f)?;
