@@ -55,6 +55,15 @@ pub enum Case {
 }
 
 impl Case {
+    /// The cases an experiment processes: (a), (b), and (c) when there is a thermal model.
+    pub fn processed(with_thermal_model: bool) -> Vec<Case> {
+        let mut c = vec![Case::Raw, Case::Room];
+        if with_thermal_model {
+            c.push(Case::Thermal);
+        }
+        c
+    }
+
     /// Short label for tables and legends.
     pub fn label(self) -> &'static str {
         match self {
@@ -864,11 +873,7 @@ pub fn vehicle_run(
             };
             let mut session = simulated_session(sc, noise, sim.lever_arm_b_m)?;
             session.smooth = smooth_this;
-            let mut cases = vec![Case::Raw, Case::Room];
-            if thermal.is_some() {
-                cases.push(Case::Thermal);
-            }
-            let results: Vec<CaseRun> = cases
+            let results: Vec<CaseRun> = Case::processed(thermal.is_some())
                 .par_iter()
                 .map(|&case| {
                     let out = match compensate(&sim.imu, case, thermal) {
@@ -919,11 +924,7 @@ pub fn vehicle_run(
                     .map_err(|e| ExperimentError::stage("reference", e))?;
                 from_nav_states(sm.epochs.iter().map(|e| &e.nav))
             };
-            let mut cases = vec![Case::Raw, Case::Room];
-            if thermal.is_some() {
-                cases.push(Case::Thermal);
-            }
-            let results: Vec<CaseRun> = cases
+            let results: Vec<CaseRun> = Case::processed(thermal.is_some())
                 .par_iter()
                 .map(|&case| {
                     // With a thermal model (csv data with temperature): (b) its room
