@@ -189,31 +189,26 @@ pub fn ratio_interval(
         .map(|(a, b)| (*a, *b))
         .collect();
     let n = pairs.len();
-    let ratio_of = |idx: &mut dyn Iterator<Item = usize>| {
-        let (mut s1, mut s2) = (0.0, 0.0);
-        for i in idx {
-            s1 += pairs[i].0;
-            s2 += pairs[i].1;
-        }
-        s1 / s2
-    };
     if n == 0 {
         return None;
     }
-    let ratio = ratio_of(&mut (0..n));
+    let sum = |f: fn(&(f64, f64)) -> f64| pairs.iter().map(f).sum::<f64>();
+    let ratio = sum(|p| p.0) / sum(|p| p.1);
     if !ratio.is_finite() {
         return None;
     }
     const RESAMPLES: usize = 4000;
     let mut state = seed;
-    let mut next = || {
-        state = splitmix64(state);
-        (state % n as u64) as usize
-    };
     let mut rs: Vec<f64> = (0..RESAMPLES)
         .map(|_| {
-            let idx: Vec<usize> = (0..n).map(|_| next()).collect();
-            ratio_of(&mut idx.into_iter())
+            let (mut s1, mut s2) = (0.0, 0.0);
+            for _ in 0..n {
+                state = splitmix64(state);
+                let (a, b) = pairs[(state % n as u64) as usize];
+                s1 += a;
+                s2 += b;
+            }
+            s1 / s2
         })
         .filter(|r| r.is_finite())
         .collect();
@@ -290,15 +285,6 @@ pub fn summarise(runs: &[VehicleRun], confidence: f64, seed: u64) -> MonteCarloS
     }
 }
 
-fn strip(mut r: VehicleRun) -> VehicleRun {
-    r.reference = None;
-    r.fixes = None;
-    for c in &mut r.cases {
-        c.forward_solution = None;
-    }
-    r
-}
-
 /// Runs the whole experiment: the noise stage once, then `runs` (default: the
 /// scenario's) chamber + vehicle runs. `progress(stage, done, total)` is called as
 /// stages finish.
@@ -335,7 +321,7 @@ pub fn run_experiment(
         })
         .collect::<Result<_, ExperimentError>>()?;
     let mut all = Vec::with_capacity(k);
-    all.push(strip(detailed.clone()));
+    all.push(detailed.without_solutions());
     all.extend(rest);
     let summary = summarise(
         &all,

@@ -156,33 +156,12 @@ impl RatesWithTemperature {
                 a[j].push(fc[j]);
             }
         }
-        let mut channels = Vec::with_capacity(6);
-        for (j, v) in g.into_iter().enumerate() {
-            channels.push(crate::io::Channel {
-                name: format!("gyro_{}", ["x", "y", "z"][j]),
-                quantity: Quantity::AngularRate,
-                source_unit: "rad/s".into(),
-                values: v,
-            });
-        }
-        for (j, v) in a.into_iter().enumerate() {
-            channels.push(crate::io::Channel {
-                name: format!("acc_{}", ["x", "y", "z"][j]),
-                quantity: Quantity::SpecificForce,
-                source_unit: "m/s^2".into(),
-                values: v,
-            });
-        }
-        let tau0 = crate::eval::reference::median_interval_s(&self.time_s);
-        let log = ImuLog::new(
-            format!("{} ({label})", self.source),
-            Some(self.time_s.clone()),
-            tau0,
-            channels,
-        );
-        crate::nav::pipeline::imu_from_rates_log(
-            &log,
-            &crate::nav::pipeline::RateChannels::ByQuantity,
+        crate::nav::pipeline::rates_to_stream(
+            &format!("{} ({label})", self.source),
+            None,
+            &self.time_s,
+            g.each_ref().map(Vec::as_slice),
+            a.each_ref().map(Vec::as_slice),
             &ImuStreamOptions::default(),
         )
         .map_err(|e| e.to_string())
@@ -688,49 +667,68 @@ pub struct VehicleRun {
 }
 
 impl VehicleRun {
+    /// A copy without the reference, fixes and solutions (for the Monte Carlo list).
+    pub fn without_solutions(&self) -> VehicleRun {
+        VehicleRun {
+            run: self.run,
+            cases: self
+                .cases
+                .iter()
+                .map(|c| CaseRun {
+                    case: c.case,
+                    forward: c.forward.clone(),
+                    smoothed: c.smoothed.clone(),
+                    gnss_accepted: c.gnss_accepted,
+                    gnss_rejected: c.gnss_rejected,
+                    forward_solution: None,
+                })
+                .collect(),
+            reference: None,
+            fixes: None,
+            temperature_c: self.temperature_c,
+        }
+    }
+
     /// The case `c`, if it was processed.
     pub fn case(&self, c: Case) -> Option<&CaseRun> {
         self.cases.iter().find(|r| r.case == c)
     }
 }
 
-fn imu_stream(out: &SensorOutput, source: &str) -> ImuStream {
-    ImuStream {
-        source: source.to_string(),
-        gps_week: None,
-        nominal_dt_s: out.dt_s,
-        epochs: out.to_increments(),
-        gaps: Vec::new(),
-    }
-}
-
-/// Applies a case's compensation to a copy of simulated rates.
-fn compensate(
+/// The navigation stream of one case from simulated rates: the increments of
+/// [`SensorOutput::to_increments`] (Δθ = ω·Δt, Δv = f·Δt) of the raw, room-calibrated or
+/// thermally compensated rates.
+fn case_stream(
     raw: &SensorOutput,
     case: Case,
     thermal: Option<&ThermalStage>,
-) -> Result<SensorOutput, String> {
-    let mut out = raw.clone();
-    let Some(t) = thermal else {
-        return Ok(out);
-    };
-    let room = *t.model.calibration();
-    for k in 0..out.len() {
-        let (g, a) = (raw.gyro_at(k), raw.accel_at(k));
-        let (gc, ac) = match case {
-            Case::Raw => return Ok(out),
-            Case::Room => (room.gyro.apply(g), room.accel.apply(a)),
-            Case::Thermal => t
-                .model
-                .compensate(g, a, raw.temperature_c[k])
-                .map_err(|e| format!("sample {k}: {e}"))?,
-        };
-        for j in 0..3 {
-            out.gyro[j][k] = gc[j];
-            out.accel[j][k] = ac[j];
+) -> Result<ImuStream, String> {
+    if raw.kind != OutputKind::Rates {
+        return Err("the simulated vehicle IMU must output rates".into());
+    }
+    let mut epochs = raw.to_increments();
+    if let (Some(t), Case::Room | Case::Thermal) = (thermal, case) {
+        let room = *t.model.calibration();
+        for (k, e) in epochs.iter_mut().enumerate() {
+            let (g, a) = (raw.gyro_at(k), raw.accel_at(k));
+            let (gc, ac) = if case == Case::Room {
+                (room.gyro.apply(g), room.accel.apply(a))
+            } else {
+                t.model
+                    .compensate(g, a, raw.temperature_c[k])
+                    .map_err(|e| format!("sample {k}: {e}"))?
+            };
+            e.dtheta_rad = gc.map(|v| v * raw.dt_s);
+            e.dvel_m_s = ac.map(|v| v * raw.dt_s);
         }
     }
-    Ok(out)
+    Ok(ImuStream {
+        source: case.label().to_string(),
+        gps_week: None,
+        nominal_dt_s: raw.dt_s,
+        epochs,
+        gaps: Vec::new(),
+    })
 }
 
 /// Filter noise: the noise model's terms (bias as Gauss–Markov with the scenario's τ,
@@ -876,15 +874,13 @@ pub fn vehicle_run(
             let results: Vec<CaseRun> = Case::processed(thermal.is_some())
                 .par_iter()
                 .map(|&case| {
-                    let out = match compensate(&sim.imu, case, thermal) {
-                        Ok(o) => o,
-                        Err(e) => {
-                            return CaseRun::failed(case, format!("compensation: {e}"));
-                        }
+                    let imu = match case_stream(&sim.imu, case, thermal) {
+                        Ok(s) => s,
+                        Err(e) => return CaseRun::failed(case, format!("compensation: {e}")),
                     };
                     let input = CaseInput {
                         case,
-                        imu: imu_stream(&out, case.label()),
+                        imu,
                         fixes,
                         session: session.clone(),
                         // Without a room calibration, (b) removes the static-start gyro bias.

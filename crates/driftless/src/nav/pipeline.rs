@@ -632,7 +632,10 @@ pub fn imu_from_rates_log(
     rates_to_stream(source, None, time_s, gyro, accel, opts)
 }
 
-fn rates_to_stream(
+/// Stream from rate columns (angular rate rad/s, specific force m/s²) at time stamps
+/// `time_s` (GPS s): Δθ = ω·Δt, Δv = f·Δt with Δt from successive stamps, as
+/// [`imu_from_rates_log`] does for a log.
+pub fn rates_to_stream(
     source: &str,
     gps_week: Option<u16>,
     time_s: &[f64],
