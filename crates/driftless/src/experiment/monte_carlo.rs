@@ -313,8 +313,19 @@ pub fn run_experiment(
     let rest: Vec<VehicleRun> = (1..k)
         .into_par_iter()
         .map(|i| {
-            let t = thermal_stage(p, noise.as_ref(), i)?;
-            let r = vehicle_run(p, noise.as_ref(), t.as_ref(), i, false)?;
+            // A simulated chamber is redrawn per run; a model file is read once.
+            let redrawn = if p
+                .scenario
+                .chamber
+                .as_ref()
+                .is_some_and(|c| c.protocol.is_some())
+            {
+                Some(thermal_stage(p, noise.as_ref(), i)?)
+            } else {
+                None
+            };
+            let t = redrawn.as_ref().map_or(thermal.as_ref(), Option::as_ref);
+            let r = vehicle_run(p, noise.as_ref(), t, i, false)?;
             let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress("runs", d, k as u64);
             Ok(r)

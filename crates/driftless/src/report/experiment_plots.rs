@@ -67,7 +67,8 @@ pub fn fit_to_width(mut fig: Figure, max_width: f64) -> Figure {
     fig
 }
 
-/// Finite `[north, east]` points as `(east, north)`, i.e. `(x, y)`.
+/// `[north, east]` points as `(east, north)`, i.e. `(x, y)` (non-finite ones pass through;
+/// the plot skips them).
 fn en(points: &[[f64; 2]]) -> (Vec<f64>, Vec<f64>) {
     points.iter().map(|p| (p[1], p[0])).unzip()
 }
