@@ -37,6 +37,19 @@
 //! leaves its increments between the adjacent visits of an axis, but those are half a
 //! dwell plus a move apart instead of one or more dwells.
 //!
+//! ## Position cycles (`position_cycles`)
+//!
+//! The position sequence of a step (six positions, or the palindrome) can be run c times
+//! back to back, each visit 1/c as long (the total dwell per orientation is unchanged, so
+//! is the white-noise part of every mean). The reason is the flicker (bias instability
+//! B): its Allan deviation is flat, ≈ 0.664·B at every averaging time, so the difference
+//! of two adjacent visit means — which is what a scale factor (f̄₊ − f̄₋)/(2g) is made
+//! of — has about the same σ ≈ √2·0.664·B whether a visit lasts 15 s or 60 s. Only more
+//! reversals help: the c independent differences average to σ/√c. With the `adi-like`
+//! accelerometers (B = 200 µg) one palindrome per step leaves ≈ 6e-5 of scale-factor
+//! noise per step against a thermal swing of 3e-3 (accelerometer z); three cycles
+//! cut it by √3 for one extra move per visit.
+//!
 //! The IMU stays at a fixed location (no lever arm: the table rotates about the IMU),
 //! so the ideal specific force in every static position is exactly the normal gravity
 //! of the site along the up axis ([`ChamberManifest::gravity_m_s2`]). Over whole
@@ -112,9 +125,15 @@ pub struct ChamberConfig {
     /// measure at once; the earlier the first positions, the less rate random walk since
     /// turn-on sits in every bias value ([`crate::thermal::soak`]).
     pub first_soak_s: Option<f64>,
-    /// Dwell per static position, s (default 60; with [`StepOrder::Palindromic`] the
-    /// total over both visits of the position).
+    /// Dwell per static position, s (default 60; with [`StepOrder::Palindromic`] or
+    /// `position_cycles` > 1 the total over all visits of the position).
     pub position_dwell_s: f64,
+    /// How many times the position sequence of a step is run (default 1): the six
+    /// positions (sequential) or the palindrome (palindromic) repeated back to back,
+    /// each visit `position_dwell_s` / (visits per position) long. More reversals per
+    /// step average the flicker between the +k and −k visits that the scale factors
+    /// difference (module docs, "Position cycles").
+    pub position_cycles: u32,
     /// Duration of each rotation between positions, s (default 10).
     pub move_s: f64,
     /// Rate-table rate |ω|, deg/s (default 50; adjusted to whole samples, see module docs).
@@ -147,6 +166,7 @@ impl Default for ChamberConfig {
             soak_s: 3600.0,
             first_soak_s: None,
             position_dwell_s: 60.0,
+            position_cycles: 1,
             move_s: 10.0,
             rate_deg_s: 50.0,
             rate_revolutions: 5,
@@ -419,6 +439,12 @@ impl ChamberConfig {
                 "must be at least 1",
             ));
         }
+        if self.position_cycles == 0 {
+            return Err(SensorSimError::invalid(
+                "chamber.position_cycles = 0",
+                "must be at least 1",
+            ));
+        }
         let palindromic = self.step_order == StepOrder::Palindromic;
         if palindromic && !self.rate_revolutions.is_multiple_of(2) {
             return Err(SensorSimError::invalid(
@@ -452,11 +478,7 @@ impl ChamberConfig {
             }
         }
         // Every duration must be at least one sample.
-        let dwell = if palindromic {
-            0.5 * self.position_dwell_s
-        } else {
-            self.position_dwell_s
-        };
+        let dwell = self.visit_dwell_s();
         for (name, d) in [
             ("soak_s", self.soak_s),
             ("first_soak_s", self.first_soak_s.unwrap_or(self.soak_s)),
@@ -474,6 +496,16 @@ impl ChamberConfig {
         Ok(())
     }
 
+    /// Dwell of one visit of a static position, s: `position_dwell_s` over the visits
+    /// per position of a step (2 per cycle palindromic, 1 sequential).
+    pub fn visit_dwell_s(&self) -> f64 {
+        let per_cycle = match self.step_order {
+            StepOrder::Sequential => 1.0,
+            StepOrder::Palindromic => 2.0,
+        };
+        self.position_dwell_s / (per_cycle * f64::from(self.position_cycles.max(1)))
+    }
+
     /// Build the protocol (module docs). Durations are rounded to whole samples.
     pub fn build(&self) -> Result<ChamberProtocol, SensorSimError> {
         self.validate()?;
@@ -481,25 +513,24 @@ impl ChamberConfig {
         let dt = 1.0 / fs;
         let ns = |d: f64| ((d * fs).round() as u64).max(1);
         // Positions and signed rates of one step, and the length of each dwell / spin.
-        let (positions, n_dwell, signs, revs): (Vec<SignedAxis>, u64, &[f64], u32) =
-            match self.step_order {
-                StepOrder::Sequential => (
-                    SignedAxis::POSITIONS.to_vec(),
-                    ns(self.position_dwell_s),
-                    &[1.0, -1.0],
-                    self.rate_revolutions,
-                ),
-                StepOrder::Palindromic => (
-                    SignedAxis::POSITIONS
-                        .iter()
-                        .chain(SignedAxis::POSITIONS.iter().rev())
-                        .copied()
-                        .collect(),
-                    ns(0.5 * self.position_dwell_s),
-                    &[1.0, -1.0, -1.0, 1.0],
-                    self.rate_revolutions / 2,
-                ),
-            };
+        let (cycle, signs, revs): (Vec<SignedAxis>, &[f64], u32) = match self.step_order {
+            StepOrder::Sequential => (
+                SignedAxis::POSITIONS.to_vec(),
+                &[1.0, -1.0],
+                self.rate_revolutions,
+            ),
+            StepOrder::Palindromic => (
+                SignedAxis::POSITIONS
+                    .iter()
+                    .chain(SignedAxis::POSITIONS.iter().rev())
+                    .copied()
+                    .collect(),
+                &[1.0, -1.0, -1.0, 1.0],
+                self.rate_revolutions / 2,
+            ),
+        };
+        let positions = cycle.repeat(self.position_cycles as usize);
+        let n_dwell = ns(self.visit_dwell_s());
         let n_spin = ns(revs as f64 * 360.0 / self.rate_deg_s);
         let omega = revs as f64 * std::f64::consts::TAU / (n_spin as f64 * dt);
         let n_ramp = ns(self.spin_s);
@@ -657,6 +688,15 @@ mod tests {
         }
     }
 
+    /// Sample-weighted mean time of segments, s.
+    fn mean_time(segs: &[&Segment]) -> f64 {
+        let w: f64 = segs.iter().map(|s| s.duration_s()).sum();
+        segs.iter()
+            .map(|s| s.duration_s() * 0.5 * (s.start_s + s.end_s))
+            .sum::<f64>()
+            / w
+    }
+
     #[test]
     fn positions_put_the_named_axis_up() {
         for up in SignedAxis::POSITIONS {
@@ -793,13 +833,6 @@ mod tests {
         let m = &p.manifest;
         let steps = m.steps();
         assert_eq!(steps.len(), 2);
-        let mean_time = |segs: &[&Segment]| {
-            let w: f64 = segs.iter().map(|s| s.duration_s()).sum();
-            segs.iter()
-                .map(|s| s.duration_s() * 0.5 * (s.start_s + s.end_s))
-                .sum::<f64>()
-                / w
-        };
         for (set, range) in steps {
             let segs = &m.segments[range];
             let mut centre = None;
@@ -885,38 +918,99 @@ mod tests {
         assert!(e.to_string().contains("even"), "{e}");
     }
 
+    /// Position cycles: the sequence of a step repeated c times, each visit 1/(visits per
+    /// position) of the dwell, the ± visits still centred on one instant (palindromic),
+    /// and the TOML key round-trips (zero cycles: `rejects_bad_settings`).
+    #[test]
+    fn position_cycles_repeat_the_sequence() {
+        for (order, cycles, visits) in [
+            (StepOrder::Sequential, 2, 2),
+            (StepOrder::Palindromic, 3, 6),
+        ] {
+            let cfg = ChamberConfig {
+                step_order: order,
+                rate_revolutions: 2,
+                position_cycles: cycles,
+                ..small()
+            };
+            assert!((cfg.visit_dwell_s() - 3.0 / visits as f64).abs() < 1e-12);
+            let p = cfg.build().unwrap();
+            let m = &p.manifest;
+            for (set, range) in m.steps() {
+                let segs = &m.segments[range];
+                for up in SignedAxis::POSITIONS {
+                    let v: Vec<&Segment> = segs
+                        .iter()
+                        .filter(|s| s.kind == SegmentKind::Position { up })
+                        .collect();
+                    // Back-to-back visits of one orientation (the turn of a palindrome,
+                    // the join of two cycles) are separate segments of one dwell.
+                    assert_eq!(v.len(), visits, "{set} °C {up}");
+                    let total: f64 = v.iter().map(|s| s.duration_s()).sum();
+                    assert!((total - 3.0).abs() < 1e-9, "{set} °C {up}: {total}");
+                    if order == StepOrder::Palindromic {
+                        let down = SignedAxis::new(up.axis, !up.positive);
+                        let w: Vec<&Segment> = segs
+                            .iter()
+                            .filter(|s| s.kind == SegmentKind::Position { up: down })
+                            .collect();
+                        let (a, b) = (mean_time(&v), mean_time(&w));
+                        assert!((a - b).abs() < 1e-9, "{set} °C {up}: {a} vs {b}");
+                    }
+                }
+            }
+            let text = toml::to_string(&cfg).unwrap();
+            assert!(
+                text.contains(&format!("position_cycles = {cycles}")),
+                "{text}"
+            );
+            assert_eq!(toml::from_str::<ChamberConfig>(&text).unwrap(), cfg);
+        }
+    }
+
     #[test]
     fn rejects_bad_settings() {
-        let e = ChamberConfig {
-            lag_tau_s: 0.0,
-            ..small()
+        let cases = [
+            (
+                ChamberConfig {
+                    lag_tau_s: 0.0,
+                    ..small()
+                },
+                "lag_tau_s = 0",
+            ),
+            (
+                ChamberConfig {
+                    temperatures_c: vec![],
+                    ..small()
+                },
+                "at least one set temperature",
+            ),
+            (
+                ChamberConfig {
+                    rate_revolutions: 0,
+                    ..small()
+                },
+                "rate_revolutions = 0",
+            ),
+            (
+                ChamberConfig {
+                    position_cycles: 0,
+                    ..small()
+                },
+                "position_cycles = 0",
+            ),
+            (
+                ChamberConfig {
+                    ramp_c_per_min: Some(1.0),
+                    ..small()
+                },
+                "ramp",
+            ),
+        ];
+        for (cfg, want) in cases {
+            let e = cfg.build().unwrap_err().to_string();
+            assert!(e.contains(want), "{want}: {e}");
         }
-        .build()
-        .unwrap_err();
-        assert!(e.to_string().contains("lag_tau_s = 0"), "{e}");
-        assert!(
-            ChamberConfig {
-                temperatures_c: vec![],
-                ..small()
-            }
-            .build()
-            .is_err()
-        );
-        assert!(
-            ChamberConfig {
-                rate_revolutions: 0,
-                ..small()
-            }
-            .build()
-            .is_err()
-        );
-        let e = ChamberConfig {
-            ramp_c_per_min: Some(1.0),
-            ..small()
-        }
-        .build()
-        .unwrap_err();
-        assert!(e.to_string().contains("ramp"), "{e}");
         assert!(toml::from_str::<ChamberConfig>("soak = 10\n").is_err());
     }
 }

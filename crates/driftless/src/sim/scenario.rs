@@ -814,6 +814,30 @@ outages = "8+5"
         assert!(e.contains("150"), "{e}");
     }
 
+    /// The chamber examples parse and build their protocol (the recommended one with its
+    /// 22 steps, palindromic order and three position cycles).
+    #[test]
+    fn chamber_examples_build() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios");
+        for (file, steps) in [
+            ("chamber-adi.toml", 20),
+            ("chamber-adi-recommended.toml", 22),
+        ] {
+            let text = std::fs::read_to_string(dir.join(file)).expect(file);
+            let sc: Scenario = toml::from_str(&text).expect(file);
+            let TrajectorySpec::Chamber(c) = &sc.trajectory else {
+                panic!("{file}: not a chamber")
+            };
+            let p = c.build().expect(file);
+            assert_eq!(p.manifest.steps().len(), steps, "{file}");
+            if steps == 22 {
+                assert_eq!(c.position_cycles, 3);
+                assert_eq!(c.step_order, super::super::chamber::StepOrder::Palindromic);
+                assert_eq!(c.visit_dwell_s(), 5.0);
+            }
+        }
+    }
+
     #[test]
     fn static_scenario_with_ideal_sensor_is_exact() {
         let text = r#"
