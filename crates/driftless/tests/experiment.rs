@@ -3,8 +3,8 @@
 //! * `builtin_monte_carlo_thermal_model_pays`: the built-in `adi-like` scenario (the demo)
 //!   over 20 Monte Carlo runs — case (c) room + thermal has a lower mean 60-s outage
 //!   error than case (b) room calibration only, and the 95 % bootstrap interval of the
-//!   ratio (b)/(c) lies above 1. Measured (2 cores): ratio 2.05× (1.84–2.33×); mean of
-//!   the per-run means (a) 426 m, (b) 421 m, (c) 205 m; no run fails. The paper: 8.4× (1254 m / 150 m) — the
+//!   ratio (b)/(c) lies above 1. Measured (2 cores): ratio 2.11× (1.89–2.40×); mean of
+//!   the per-run means (a) 426 m, (b) 420 m, (c) 199 m; no run fails. The paper: 8.4× (1254 m / 150 m) — the
 //!   report explains the difference; the scenario was not tuned towards it.
 //! * wrong scenarios fail in [`prepare`] (before the noise stage, i.e. before any long
 //!   computation) with a message naming the problem;
@@ -213,8 +213,8 @@ fn experiment_report_renders_in_chromium() {
 /// with the noise model and the thermal model as files from the built-in scenario's
 /// stages. All three cases run from the files; the thermal model pays as in the
 /// simulated experiment (same drive, seed of run 0).
-/// Measured: mean end error (a) 438 m, (b) 399 m, (c) 167 m. The in-memory run 0 of the
-/// built-in scenario gives 385 / 367 / 179 m on the same data: here the windows are
+/// Measured: mean end error (a) 438 m, (b) 399 m, (c) 165 m. The in-memory run 0 of the
+/// built-in scenario gives 385 / 367 / 178 m on the same data: here the windows are
 /// chosen on the GNSS fixes and the reference is the smoothed full-GNSS solution (what a
 /// user without truth has), which moves each window by a few seconds.
 #[test]
