@@ -76,6 +76,50 @@ fn soak_on_a_simulated_chamber_run() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `driftless thermal soak` on a recording of the recommended protocol (25 °C first with
+/// a 2-s soak and again last, palindromic order, two position cycles; deterministic
+/// errors): the revisited temperature gives two points, every step calibrates from its
+/// repeated positions, and the gyro x bias slope is the preset's.
+#[test]
+fn soak_on_the_recommended_protocol() {
+    let dir = std::env::temp_dir().join(format!("driftless-thermal-rec-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = "seed = 9\n[imu]\nrate_hz = 50.0\npreset = \"adi-like\"\noutput = \"rates\"\n\
+                    errors = \"deterministic\"\n[trajectory]\ntype = \"chamber\"\n\
+                    temperatures_c = [25.0, -20.0, 45.0, 0.0, 70.0, 25.0]\nfirst_soak_s = 2.0\n\
+                    soak_s = 200.0\nlag_tau_s = 5.0\nposition_dwell_s = 8.0\nmove_s = 2.0\n\
+                    step_order = \"palindromic\"\nposition_cycles = 2\nrate_revolutions = 2\n\
+                    spin_s = 1.0\n";
+    simulate(&dir, "sim", scenario);
+    let v = run_json(
+        bin()
+            .args(["thermal", "soak", "--json", "--manifest"])
+            .arg(dir.join("sim/manifest.toml"))
+            .arg(dir.join("sim/imu.csv")),
+    );
+    assert_eq!(v["series"].as_array().unwrap().len(), 12);
+    let temps: Vec<f64> = v["temperatures_c"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_f64().unwrap())
+        .collect();
+    assert_eq!(temps, [-20.0, 0.0, 25.0, 25.0, 45.0, 70.0]);
+    let s = v["series"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["triad"] == "gyro" && s["quantity"] == "bias" && s["axis"] == "x")
+        .unwrap();
+    let c1 = s["coefficients"][1].as_f64().unwrap();
+    let want = driftless::sim::presets::Preset::AdiLike
+        .config()
+        .gyro
+        .bias_poly_rad_s[0][1];
+    assert!((c1 - want).abs() <= 1e-9 * want.abs(), "c1 {c1} vs {want}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `driftless compensate`: a model from a simulated chamber run applied to a static
 /// warm-up log (25 → 45 °C) of the same simulated sensor (same seed, deterministic
 /// errors); the compensated accelerometer reads −g on z; a second pass is refused; a
