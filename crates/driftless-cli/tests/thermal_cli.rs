@@ -5,16 +5,28 @@
 mod common;
 use common::{bin, run_json, simulate};
 
+/// A 50-Hz `adi-like` chamber scenario with deterministic errors and a 40τ soak (200 s,
+/// τ = 5 s), `keys` adding the protocol's temperatures, dwell and order.
+fn deterministic_chamber(keys: &str) -> String {
+    format!(
+        "seed = 9\n[imu]\nrate_hz = 50.0\npreset = \"adi-like\"\noutput = \"rates\"\n\
+         errors = \"deterministic\"\n[trajectory]\ntype = \"chamber\"\nsoak_s = 200.0\n\
+         lag_tau_s = 5.0\nmove_s = 2.0\nspin_s = 1.0\n{keys}"
+    )
+}
+
 #[test]
 fn soak_on_a_simulated_chamber_run() {
     let dir = std::env::temp_dir().join(format!("driftless-thermal-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let scenario = "seed = 9\n[imu]\nrate_hz = 50.0\npreset = \"adi-like\"\noutput = \"rates\"\n\
-                    errors = \"deterministic\"\n[trajectory]\ntype = \"chamber\"\n\
-                    temperatures_c = [-20.0, 0.0, 25.0, 45.0, 70.0]\nsoak_s = 200.0\n\
-                    lag_tau_s = 5.0\nposition_dwell_s = 5.0\nmove_s = 2.0\nrate_revolutions = 1\n\
-                    spin_s = 1.0\n";
-    simulate(&dir, "sim", scenario);
+    simulate(
+        &dir,
+        "sim",
+        &deterministic_chamber(
+            "temperatures_c = [-20.0, 0.0, 25.0, 45.0, 70.0]\nposition_dwell_s = 5.0\n\
+             rate_revolutions = 1\n",
+        ),
+    );
     let v = run_json(
         bin()
             .args(["thermal", "soak", "--json", "--manifest"])
@@ -34,16 +46,8 @@ fn soak_on_a_simulated_chamber_run() {
     // Deterministic errors and a 40τ soak (the sensor settled to ~1e-16 °C): the gyro x
     // bias slope is the preset's to rounding (the turn-on bias shifts c0 only; with a
     // 12τ soak the unsettled lag left 3e-5).
-    let s = v["series"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|s| s["triad"] == "gyro" && s["quantity"] == "bias" && s["axis"] == "x")
-        .unwrap();
-    let c1 = s["coefficients"][1].as_f64().unwrap();
+    assert_gyro_x_bias_slope_is_the_presets(&v);
     let cfg = driftless::sim::presets::Preset::AdiLike.config();
-    let want = cfg.gyro.bias_poly_rad_s[0][1];
-    assert!((c1 - want).abs() <= 1e-9 * want.abs(), "c1 {c1} vs {want}");
     // The gyro g-sensitivity is estimated in every step by default (six positions per
     // step) and reported per step and as a mean: the preset's G.
     assert_eq!(v["gyro_g_sensitivity"].as_array().unwrap().len(), 5);
@@ -84,13 +88,15 @@ fn soak_on_a_simulated_chamber_run() {
 fn soak_on_the_recommended_protocol() {
     let dir = std::env::temp_dir().join(format!("driftless-thermal-rec-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let scenario = "seed = 9\n[imu]\nrate_hz = 50.0\npreset = \"adi-like\"\noutput = \"rates\"\n\
-                    errors = \"deterministic\"\n[trajectory]\ntype = \"chamber\"\n\
-                    temperatures_c = [25.0, -20.0, 45.0, 0.0, 70.0, 25.0]\nfirst_soak_s = 2.0\n\
-                    soak_s = 200.0\nlag_tau_s = 5.0\nposition_dwell_s = 8.0\nmove_s = 2.0\n\
-                    step_order = \"palindromic\"\nposition_cycles = 2\nrate_revolutions = 2\n\
-                    spin_s = 1.0\n";
-    simulate(&dir, "sim", scenario);
+    simulate(
+        &dir,
+        "sim",
+        &deterministic_chamber(
+            "temperatures_c = [25.0, -20.0, 45.0, 0.0, 70.0, 25.0]\nfirst_soak_s = 2.0\n\
+             position_dwell_s = 8.0\nstep_order = \"palindromic\"\nposition_cycles = 2\n\
+             rate_revolutions = 2\n",
+        ),
+    );
     let v = run_json(
         bin()
             .args(["thermal", "soak", "--json", "--manifest"])
@@ -105,6 +111,13 @@ fn soak_on_the_recommended_protocol() {
         .map(|t| t.as_f64().unwrap())
         .collect();
     assert_eq!(temps, [-20.0, 0.0, 25.0, 25.0, 45.0, 70.0]);
+    assert_gyro_x_bias_slope_is_the_presets(&v);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The fitted gyro x bias slope (c₁ of the soak JSON) equals the `adi-like` preset's to
+/// 1e-9 relative (deterministic errors, settled soak).
+fn assert_gyro_x_bias_slope_is_the_presets(v: &serde_json::Value) {
     let s = v["series"]
         .as_array()
         .unwrap()
@@ -117,7 +130,6 @@ fn soak_on_the_recommended_protocol() {
         .gyro
         .bias_poly_rad_s[0][1];
     assert!((c1 - want).abs() <= 1e-9 * want.abs(), "c1 {c1} vs {want}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `driftless compensate`: a model from a simulated chamber run applied to a static
