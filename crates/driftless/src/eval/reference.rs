@@ -146,13 +146,14 @@ pub fn sample_trajectory<T: Trajectory + ?Sized>(traj: &T, times_s: &[f64]) -> N
     for &t in times_s {
         let p = traj.point(t);
         let e = Euler::from_dcm(&p.c_bn);
-        s.time_s.push(t);
-        s.lat_rad.push(p.lat_rad);
-        s.lon_rad.push(p.lon_rad);
-        s.height_m.push(p.height_m);
-        s.vel_ned_m_s.push(p.vel_ned_m_s);
-        s.roll_pitch_yaw_rad
-            .push([e.roll_rad, e.pitch_rad, e.yaw_rad]);
+        s.push_epoch(
+            t,
+            p.lat_rad,
+            p.lon_rad,
+            p.height_m,
+            p.vel_ned_m_s,
+            [e.roll_rad, e.pitch_rad, e.yaw_rad],
+        );
     }
     s
 }
@@ -164,13 +165,14 @@ pub fn from_nav_states<'a>(states: impl IntoIterator<Item = &'a NavState>) -> Na
     let mut s = NavSolution::default();
     for n in states {
         let e = Euler::from_dcm(&n.q_bn.to_dcm());
-        s.time_s.push(n.time_s);
-        s.lat_rad.push(n.lat_rad);
-        s.lon_rad.push(n.lon_rad);
-        s.height_m.push(n.height_m);
-        s.vel_ned_m_s.push(n.vel_ned_m_s);
-        s.roll_pitch_yaw_rad
-            .push([e.roll_rad, e.pitch_rad, e.yaw_rad]);
+        s.push_epoch(
+            n.time_s,
+            n.lat_rad,
+            n.lon_rad,
+            n.height_m,
+            n.vel_ned_m_s,
+            [e.roll_rad, e.pitch_rad, e.yaw_rad],
+        );
     }
     s
 }

@@ -102,12 +102,8 @@ pub fn imu_logs_from_autopilot_file(
     path: impl AsRef<std::path::Path>,
 ) -> Result<Option<AutopilotImuLogs>, LogError> {
     let path = path.as_ref();
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|error| LogError::Io {
-        path: name.clone(),
-        error,
-    })?;
-    imu_logs_from_autopilot(&bytes, &name)
+    let bytes = crate::io::nav::read_file(path)?;
+    imu_logs_from_autopilot(&bytes, &path.display().to_string())
 }
 
 /// Little-endian scalar types of the two formats.
@@ -186,6 +182,16 @@ pub(crate) fn u16_at(b: &[u8], at: usize) -> Option<u16> {
 /// `u64` at `at`, little-endian.
 pub(crate) fn u64_at(b: &[u8], at: usize) -> Option<u64> {
     arr(b.get(at..)?).map(u64::from_le_bytes)
+}
+
+/// "NAME ×count, …": the message types or topics a log holds, for the error that says
+/// it holds no IMU data.
+pub(crate) fn list_counts(found: &[(String, usize)]) -> String {
+    found
+        .iter()
+        .map(|(n, c)| format!("{n} ×{c}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// IEEE-754 binary16 → f64 (subnormals, infinities and NaN included).

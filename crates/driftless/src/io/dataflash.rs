@@ -518,11 +518,7 @@ pub fn imu_logs_from_dataflash(bytes: &[u8], source: &str) -> Result<AutopilotIm
             format: FORMAT,
             message: format!(
                 "no IMU messages (message types: {})",
-                found
-                    .iter()
-                    .map(|(n, c)| format!("{n} ×{c}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                super::autopilot::list_counts(&found)
             ),
         });
     }

@@ -640,11 +640,7 @@ pub fn imu_logs_from_ulog(bytes: &[u8], source: &str) -> Result<AutopilotImuLogs
             format: FORMAT,
             message: format!(
                 "no sensor_gyro or sensor_accel data (topics: {})",
-                found
-                    .iter()
-                    .map(|(n, c)| format!("{n} ×{c}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                super::autopilot::list_counts(&found)
             ),
         });
     }

@@ -736,10 +736,7 @@ pub fn imu_from_tagged_csv_files(
 ) -> Result<ImuStream, PipelineError> {
     let csv_path = csv_path.as_ref();
     let tag = read_rtklib_tag_file(tag_path, crate::io::nav::FposSize::Auto)?;
-    let bytes = std::fs::read(csv_path).map_err(|error| LogError::Io {
-        path: csv_path.display().to_string(),
-        error,
-    })?;
+    let bytes = crate::io::nav::read_file(csv_path)?;
     imu_from_tagged_csv(&bytes, &csv_path.display().to_string(), &tag, opts)
 }
 
@@ -751,12 +748,8 @@ pub fn read_gnss_file(
     opts: &GnssReadOptions,
 ) -> Result<GnssFixes, PipelineError> {
     let path = path.as_ref();
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|error| LogError::Io {
-        path: name.clone(),
-        error,
-    })?;
-    read_gnss(&bytes, &name, opts)
+    let bytes = crate::io::nav::read_file(path)?;
+    read_gnss(&bytes, &path.display().to_string(), opts)
 }
 
 /// [`read_gnss_file`] from memory.

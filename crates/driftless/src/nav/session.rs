@@ -530,13 +530,14 @@ pub fn epoch_solution_records(
     for e in epochs {
         let n = &e.nav;
         let att = Euler::from_dcm(&n.q_bn.to_dcm());
-        sol.time_s.push(n.time_s);
-        sol.lat_rad.push(n.lat_rad);
-        sol.lon_rad.push(n.lon_rad);
-        sol.height_m.push(n.height_m);
-        sol.vel_ned_m_s.push(n.vel_ned_m_s);
-        sol.roll_pitch_yaw_rad
-            .push([att.roll_rad, att.pitch_rad, att.yaw_rad]);
+        sol.push_epoch(
+            n.time_s,
+            n.lat_rad,
+            n.lon_rad,
+            n.height_m,
+            n.vel_ned_m_s,
+            [att.roll_rad, att.pitch_rad, att.yaw_rad],
+        );
         err.time_s.push(n.time_s);
         err.gyro_bias_rad_s.push(e.sensors.gyro_bias_rad_s);
         err.accel_bias_m_s2.push(e.sensors.accel_bias_m_s2);

@@ -661,13 +661,14 @@ fn truth_solution<T: Trajectory + Sync + ?Sized>(
     let mut s = NavSolution::default();
     for (k, p) in pts.iter().enumerate() {
         let e = Euler::from_dcm(&p.c_bn);
-        s.time_s.push(t0 + k as f64 * dt + offset);
-        s.lat_rad.push(p.lat_rad);
-        s.lon_rad.push(p.lon_rad);
-        s.height_m.push(p.height_m);
-        s.vel_ned_m_s.push(p.vel_ned_m_s);
-        s.roll_pitch_yaw_rad
-            .push([e.roll_rad, e.pitch_rad, e.yaw_rad]);
+        s.push_epoch(
+            t0 + k as f64 * dt + offset,
+            p.lat_rad,
+            p.lon_rad,
+            p.height_m,
+            p.vel_ned_m_s,
+            [e.roll_rad, e.pitch_rad, e.yaw_rad],
+        );
     }
     s
 }

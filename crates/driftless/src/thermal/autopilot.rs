@@ -372,16 +372,26 @@ impl Default for ExportOptions {
     }
 }
 
-/// PX4 parameters of the bias part (module docs).
-pub fn px4_params(m: &BiasModel, o: &ExportOptions) -> Result<Vec<Param>, AutopilotError> {
-    let n = o.instance;
-    if n >= PX4_INSTANCES {
+/// `instance` if the autopilot has that many sensor instances (`count`), else the error
+/// naming the largest.
+fn check_instance(
+    instance: usize,
+    count: usize,
+    autopilot: &'static str,
+) -> Result<usize, AutopilotError> {
+    if instance >= count {
         return Err(AutopilotError::Instance {
-            instance: n,
-            autopilot: "PX4",
-            max: PX4_INSTANCES - 1,
+            instance,
+            autopilot,
+            max: count - 1,
         });
     }
+    Ok(instance)
+}
+
+/// PX4 parameters of the bias part (module docs).
+pub fn px4_params(m: &BiasModel, o: &ExportOptions) -> Result<Vec<Param>, AutopilotError> {
+    let n = check_instance(o.instance, PX4_INSTANCES, "PX4")?;
     let mut p = Vec::new();
     for (letter, cal, t, id) in [
         ('A', "ACC", &m.accel, o.px4_accel_id),
@@ -434,14 +444,7 @@ fn ardupilot_offs_name(accel: bool, n: usize, axis: char) -> String {
 
 /// ArduPilot parameters of the bias part (module docs).
 pub fn ardupilot_params(m: &BiasModel, o: &ExportOptions) -> Result<Vec<Param>, AutopilotError> {
-    let n = o.instance;
-    if n >= ARDUPILOT_INSTANCES {
-        return Err(AutopilotError::Instance {
-            instance: n,
-            autopilot: "ArduPilot",
-            max: ARDUPILOT_INSTANCES - 1,
-        });
-    }
+    let n = check_instance(o.instance, ARDUPILOT_INSTANCES, "ArduPilot")?;
     let g = format!("INS_TCAL{}_", n + 1);
     let mut p = vec![
         Param {

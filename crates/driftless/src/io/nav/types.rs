@@ -102,6 +102,26 @@ pub struct NavSolution {
     pub roll_pitch_yaw_rad: Vec<[f64; 3]>,
 }
 
+impl NavSolution {
+    /// Append one epoch (every column grows by one).
+    pub fn push_epoch(
+        &mut self,
+        time_s: f64,
+        lat_rad: f64,
+        lon_rad: f64,
+        height_m: f64,
+        vel_ned_m_s: [f64; 3],
+        roll_pitch_yaw_rad: [f64; 3],
+    ) {
+        self.time_s.push(time_s);
+        self.lat_rad.push(lat_rad);
+        self.lon_rad.push(lon_rad);
+        self.height_m.push(height_m);
+        self.vel_ned_m_s.push(vel_ned_m_s);
+        self.roll_pitch_yaw_rad.push(roll_pitch_yaw_rad);
+    }
+}
+
 /// Estimated IMU errors per epoch (KF-GINS's `KF_GINS_IMU_ERR.txt` content), SI.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ImuErrors {
