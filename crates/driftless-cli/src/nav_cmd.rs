@@ -1,43 +1,106 @@
 //! `driftless nav`: loosely coupled GNSS/INS on recorded data, with simulated outages.
 //!
-//! Inputs today: KF-GINS increment files or an RTKLIB-tagged IMU CSV (the `drive-0708`
-//! preset sets its units, time shift, mounting and lever arm), and GNSS as RTKLIB `.pos`
-//! or a KF-GINS GNSS file. Output: a summary (full-GNSS accuracy against the fixes,
-//! per-outage errors) and KF-GINS's three output files in `--out`.
+//! A navigation configuration (`--config nav.toml`, `--print-config` for the commented
+//! default, every key also a flag) says what the data are and how to treat them; the
+//! library runs the job ([`driftless::nav::job::run_nav_job`]); this module prints the
+//! summary and writes the outputs. `--kf-gins CONFIG.yaml` runs a KF-GINS job instead.
 
 use anyhow::{Context, Result, bail};
-use clap::{Args, ValueEnum};
+use clap::{Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
 use driftless::eval::SelectedOutage;
-use driftless::io::nav::GnssFixes;
 use driftless::io::nav::kfgins::GnssReadOptions;
 use driftless::io::nav::read_kfgins_imu_file;
+use driftless::nav::config::{KEYS, NavConfig, Override, ValueKind};
 use driftless::nav::filter::model::{FilterConfig, GaussMarkov, ImuNoise};
-use driftless::nav::outage::{OutageItem, OutageSpec, OutageStart};
+use driftless::nav::job::{choose_outages, run_nav_job};
+use driftless::nav::outage::OutageSpec;
 use driftless::nav::pipeline::{
-    GnssOutsideImu, ImuGapPolicy, ImuStreamOptions, RateChannels, TaggedCsvOptions,
-    imu_from_kfgins, imu_from_rates_log, imu_from_tagged_csv_files, read_gnss_file, select_gnss,
+    GnssOutsideImu, ImuGapPolicy, ImuStreamOptions, imu_from_kfgins, select_gnss,
 };
-use driftless::nav::session::{SessionConfig, consumer_mems_noise, run_session, solution_records};
+use driftless::nav::session::solution_records;
 use std::path::PathBuf;
 
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ImuFormat {
-    /// KF-GINS increments: time, dθ xyz [rad], dv xyz [m/s].
-    Kfgins,
-    /// RTKLIB-tagged CSV (acc [g], gyro [deg/s], tick [ms]) with a `.tag` file.
-    TaggedCsv,
-    /// Generic delimited text (or DRIFTLOG) of rates: a time column (the first unless
-    /// `--time-column`) in GPS seconds and
-    /// three angular-rate and three specific-force columns, units from the header
-    /// (`gyro_x [deg/s]`) or the input options below; Δθ = ω·Δt, Δv = f·Δt.
-    Csv,
+/// Configurations shipped with driftless (`--preset NAME`), from `examples/nav/`.
+const PRESETS: &[(&str, &str)] = &[
+    (
+        "drive0708",
+        include_str!("../../../examples/nav/drive0708.toml"),
+    ),
+    (
+        "drive_0708",
+        include_str!("../../../examples/nav/drive_0708.toml"),
+    ),
+];
+
+/// Every configuration key as a flag ([`KEYS`]); given flags override the file.
+#[derive(Clone, Debug, Default)]
+pub struct ConfigFlags {
+    /// The flags given, in table order.
+    pub overrides: Vec<Override>,
 }
 
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Preset {
-    /// `shared/data/drive/drive_0708`: tagged CSV, −0.125 s, mounting (180, 0, 180)° plus
-    /// (0, −6.79, 5.35)°, antenna (0, −0.05, 0) m from the IMU, consumer MEMS noise.
-    Drive0708,
+impl ConfigFlags {
+    /// The text of the flag for `path`, when given.
+    pub fn get(&self, path: &str) -> Option<&str> {
+        self.overrides
+            .iter()
+            .find(|o| o.key.path == path)
+            .map(|o| o.value.as_str())
+    }
+}
+
+impl FromArgMatches for ConfigFlags {
+    fn from_arg_matches(m: &ArgMatches) -> Result<Self, clap::Error> {
+        let overrides = KEYS
+            .iter()
+            .filter_map(|k| {
+                m.get_one::<String>(k.flag).map(|v| Override {
+                    key: k,
+                    value: v.clone(),
+                })
+            })
+            .collect();
+        Ok(ConfigFlags { overrides })
+    }
+    fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
+}
+
+impl Args for ConfigFlags {
+    fn augment_args(mut cmd: Command) -> Command {
+        for k in KEYS {
+            let section = k.path.split_once('.').map_or("", |(s, _)| s);
+            let heading: &'static str = match section {
+                "imu" => "Configuration [imu]",
+                "gnss" => "Configuration [gnss]",
+                "noise" => "Configuration [noise]",
+                "align" => "Configuration [align]",
+                "aids" => "Configuration [aids]",
+                "filter" => "Configuration [filter]",
+                _ => "Configuration [outages]",
+            };
+            let mut a = Arg::new(k.flag)
+                .long(k.flag)
+                .value_name(k.value_name)
+                .help(k.help)
+                .help_heading(heading)
+                .action(ArgAction::Set);
+            a = if k.kind == ValueKind::Bool {
+                a.num_args(0..=1)
+                    .require_equals(true)
+                    .default_missing_value("true")
+            } else {
+                a.allow_hyphen_values(true)
+            };
+            cmd = cmd.arg(a);
+        }
+        cmd
+    }
+    fn augment_args_for_update(cmd: Command) -> Command {
+        Self::augment_args(cmd)
+    }
 }
 
 #[derive(Args, Debug)]
@@ -45,40 +108,19 @@ pub struct NavArgs {
     /// Run a KF-GINS configuration unchanged: its IMU and GNSS files, initial state, noise,
     /// lever arm and time span; KF-GINS's three output files go to its `outputpath`
     /// (relative paths resolve against the working directory, as in KF-GINS).
-    #[arg(long, value_name = "CONFIG.yaml", conflicts_with_all = ["imu", "gnss", "preset"])]
+    #[arg(long, value_name = "CONFIG.yaml", conflicts_with_all = ["imu", "gnss", "preset", "config"])]
     pub kf_gins: Option<PathBuf>,
-    /// IMU file.
-    #[arg(long, required_unless_present = "kf_gins")]
-    pub imu: Option<PathBuf>,
-    /// IMU file format (set by --preset).
-    #[arg(long, value_enum)]
-    pub imu_format: Option<ImuFormat>,
-    /// RTKLIB time-tag file for a tagged CSV (default: IMU path + `.tag`).
+    /// Navigation configuration (TOML; `--print-config` writes the commented default).
+    #[arg(long, value_name = "NAV.toml")]
+    pub config: Option<PathBuf>,
+    /// A configuration shipped with driftless: `drive_0708` (the shared drive, published
+    /// values only) or `drive0708` (the same with settings tuned on that drive).
+    #[arg(long, value_name = "NAME", conflicts_with = "config")]
+    pub preset: Option<String>,
+    /// Print the commented default configuration (or, with --config/--preset and flags,
+    /// the configuration in effect) and exit.
     #[arg(long)]
-    pub tag: Option<PathBuf>,
-    /// GNSS file: RTKLIB `.pos` or KF-GINS GNSS text.
-    #[arg(long, required_unless_present = "kf_gins")]
-    pub gnss: Option<PathBuf>,
-    /// Settings for a known dataset.
-    #[arg(long, value_enum)]
-    pub preset: Option<Preset>,
-    /// Antenna lever arm from the IMU in the body frame, forward,right,down [m].
-    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
-    pub lever_arm: Option<String>,
-    /// Apply a calibration model file (`driftless calibrate --out`) to the IMU before
-    /// navigation; its raw units must be SI (rad/s, m/s²), as the IMU readers deliver.
-    #[arg(long, value_name = "FILE.toml")]
-    pub calibration: Option<PathBuf>,
-    /// IMU noise from an Allan noise-model file (`driftless allan --save-model`); default
-    /// consumer-MEMS values.
-    #[arg(long)]
-    pub noise_model: Option<PathBuf>,
-    /// GNSS outages: `none`, `300+60,600+60` (s after the first fix), `@243600+60`
-    /// (absolute), `6x60s every 85s from 50s`, or `auto:9x60` (nine 60-s windows chosen
-    /// on the GNSS track to cover straight runs, turns, accelerations, braking and stops,
-    /// at least max(2·60, 120) s apart, 60 s after the first fix and 30 s before the last).
-    #[arg(long, default_value = "none")]
-    pub outages: String,
+    pub print_config: bool,
     /// Folder for KF-GINS-format output files.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -88,13 +130,18 @@ pub struct NavArgs {
     /// Also write the track as GeoJSON (one point per 0.1 s).
     #[arg(long, value_name = "FILE")]
     pub geojson: Option<PathBuf>,
-    /// Also run the RTS smoother and report its in-outage errors (on by default with
-    /// `--preset drive0708`).
-    #[arg(long)]
-    pub smooth: bool,
     /// Machine-readable summary.
     #[arg(long)]
     pub json: bool,
+    /// No notes on stderr (results and errors only).
+    #[arg(long, short = 'q', conflicts_with = "verbose")]
+    pub quiet: bool,
+    /// Every note, and every rejected GNSS fix.
+    #[arg(long, short = 'v')]
+    pub verbose: bool,
+    /// The configuration keys as flags.
+    #[command(flatten)]
+    pub settings: ConfigFlags,
     /// How to read a generic CSV IMU file (`--imu-format csv`).
     #[command(
         flatten,
@@ -103,178 +150,156 @@ pub struct NavArgs {
     pub input: crate::input::InputArgs,
 }
 
-fn parse_vec3(s: &str, what: &str) -> Result<[f64; 3]> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("{what} {s:?}: expected three comma-separated numbers"))?;
-    match v.as_slice() {
-        [a, b, c] if v.iter().all(|x| x.is_finite()) => Ok([*a, *b, *c]),
-        _ => bail!("{what} {s:?}: expected three finite comma-separated numbers"),
+impl NavArgs {
+    /// The outage specification given as a flag (`--outages`), default `none`.
+    pub fn outages_spec(&self) -> &str {
+        self.settings.get("outages.spec").unwrap_or("none")
     }
+}
+
+fn load_config(a: &NavArgs) -> Result<driftless::nav::config::LoadedConfig> {
+    let overrides = &a.settings.overrides;
+    if let Some(name) = &a.preset {
+        let Some((_, text)) = PRESETS.iter().find(|(n, _)| n == name) else {
+            bail!(
+                "--preset {name:?}: no such preset; shipped: {}",
+                PRESETS
+                    .iter()
+                    .map(|(n, _)| *n)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        };
+        return Ok(NavConfig::load_text(
+            Some((
+                (*text).to_owned(),
+                PathBuf::from(format!("preset {name}")),
+                PathBuf::new(),
+            )),
+            overrides,
+        )?);
+    }
+    Ok(NavConfig::load(a.config.as_deref(), overrides)?)
 }
 
 pub fn run(a: NavArgs) -> Result<()> {
     if let Some(cfg_path) = &a.kf_gins {
         return run_kf_gins(cfg_path, &a);
     }
-    let (Some(imu_path), Some(gnss_path)) = (a.imu.clone(), a.gnss.clone()) else {
-        bail!("--imu and --gnss are required without --kf-gins");
-    };
-    let imu_file = imu_path;
-    let gnss_file = gnss_path;
-    let format = match (a.imu_format, a.preset) {
-        (Some(f), _) => f,
-        (None, Some(Preset::Drive0708)) => ImuFormat::TaggedCsv,
-        (None, None) => ImuFormat::Kfgins,
-    };
-    let imu = match format {
-        ImuFormat::Kfgins => {
-            let inc = read_kfgins_imu_file(&imu_file)?;
-            imu_from_kfgins(
-                &inc,
-                &imu_file.display().to_string(),
-                &ImuStreamOptions::default(),
-            )?
+    if a.print_config {
+        if a.config.is_none() && a.preset.is_none() && a.settings.overrides.is_empty() {
+            print!("{}", NavConfig::default_toml());
+        } else {
+            let c = load_config(&a)?;
+            print!("{}", toml::to_string_pretty(&c.config)?);
         }
-        ImuFormat::TaggedCsv => {
-            let tag = a.tag.clone().unwrap_or_else(|| {
-                let mut p = imu_file.clone().into_os_string();
-                p.push(".tag");
-                PathBuf::from(p)
-            });
-            let opts = match a.preset {
-                Some(Preset::Drive0708) => TaggedCsvOptions::drive_0708(),
-                None => TaggedCsvOptions::default(),
-            };
-            imu_from_tagged_csv_files(&imu_file, &tag, &opts)?
-        }
-        ImuFormat::Csv => {
-            // Navigation needs time stamps: the first column unless told otherwise.
-            let mut input = a.input.clone();
-            input.time_column.get_or_insert_with(|| "1".into());
-            let log = input.read(&imu_file)?;
-            imu_from_rates_log(
-                &log,
-                &RateChannels::ByQuantity,
-                &ImuStreamOptions::default(),
-            )?
-        }
-    };
-    let mut imu = imu;
-    if let Some(p) = &a.calibration {
-        let f = driftless::calib::model_file::CalibrationFile::load(p)?;
-        for (t, si) in [(&f.accel, ["m/s^2", "m/s²"]), (&f.gyro, ["rad/s", "rad/s"])] {
-            if !si.contains(&t.raw_unit.as_str()) {
-                bail!(
-                    "{}: raw unit {:?}: nav reads SI samples, so it can apply only a \
-                     calibration of SI samples ({} / rad/s)",
-                    p.display(),
-                    t.raw_unit,
-                    si[0]
-                );
-            }
-        }
-        imu.apply_calibration(&f.calibration());
+        return Ok(());
     }
-    let gnss = read_gnss_file(&gnss_file, &GnssReadOptions::default())?;
-    let lever = match (&a.lever_arm, a.preset) {
-        (Some(s), _) => parse_vec3(s, "--lever-arm")?,
-        (None, Some(Preset::Drive0708)) => [0.0, -0.05, 0.0],
-        (None, None) => [0.0, 0.0, 0.0],
-    };
-    let noise = match &a.noise_model {
-        Some(p) => {
-            let m = driftless::allan::noise_model::NoiseModel::load(p)?;
-            let scale = GaussMarkov {
-                sigma: 5e-3,
-                tau_s: 3600.0,
-            };
-            ImuNoise::from_noise_model(&m, 3600.0, scale, scale)?
+    let cfg = load_config(&a)?;
+    // Navigation needs time stamps: the first column unless told otherwise.
+    let mut input = a.input.clone();
+    input.time_column.get_or_insert_with(|| "1".into());
+    let csv = input.text_options()?;
+    let job = run_nav_job(&cfg, &csv)?;
+    let note = |m: &str| {
+        if !a.quiet {
+            eprintln!("note: {m}");
         }
-        None => consumer_mems_noise(),
     };
-    let spec: OutageSpec = a.outages.parse().context("--outages")?;
-    let all = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)?;
-    let (spec, selection) = choose_outages(spec, &all.fixes)?;
-    let windows = select_gnss(&gnss, &imu, &spec, GnssOutsideImu::Drop)?.windows;
-    let mut cfg = match a.preset {
-        Some(Preset::Drive0708) => SessionConfig::drive_0708(),
-        None => SessionConfig::new(FilterConfig::new(noise, lever)),
-    };
-    if a.preset.is_some() {
-        if a.noise_model.is_some() {
-            cfg.filter.imu = noise;
-        }
-        cfg.filter.lever_arm_b_m = lever;
+    for n in &job.notes {
+        note(n);
     }
-    cfg.smooth |= a.smooth;
-    cfg.outages = windows;
-    let res = run_session(&imu, &all.fixes, &cfg)?;
-
-    log_rejections(&res.run, 20);
-    let (sol, err, std) = solution_records(&res.run);
+    let res = &job.session;
+    let run = &res.run;
+    if a.verbose {
+        log_rejections(run, usize::MAX);
+    } else if !a.quiet && run.gnss_rejected > 0 {
+        let worst = run.rejections().map(|o| o.nis).fold(0.0f64, f64::max);
+        let first = run.rejections().next().map_or(f64::NAN, |o| o.time_s);
+        note(&format!(
+            "{} GNSS measurements rejected by the gate (first at {first:.3} s, largest NIS {worst:.1}); --verbose lists them",
+            run.gnss_rejected
+        ));
+    }
+    let (sol, err, std) = solution_records(run);
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        driftless::io::nav::write_kfgins_outputs(dir, &sol, &err, &std, imu.gps_week.unwrap_or(0))?;
+        driftless::io::nav::write_kfgins_outputs(
+            dir,
+            &sol,
+            &err,
+            &std,
+            job.imu.gps_week.unwrap_or(0),
+        )?;
     }
-    write_extra_outputs(&a, &sol, imu.nominal_dt_s)?;
+    write_extra_outputs(&a, &sol, job.imu.nominal_dt_s)?;
     let ends: Vec<f64> = res
         .outages
         .iter()
         .filter_map(|o| o.end_horizontal_m)
         .collect();
     let mean_end = (!ends.is_empty()).then(|| ends.iter().sum::<f64>() / ends.len() as f64);
+    let sc = &job.session_config;
     if a.json {
         let v = serde_json::json!({
-            "imu_epochs": imu.len(),
-            "gnss_fixes": all.fixes.time_s.len(),
+            "imu_epochs": job.imu.len(),
+            "imu_format": format!("{:?}", job.imu_format),
+            "imu_rate_hz": 1.0 / job.imu.nominal_dt_s,
+            "gnss_fixes": job.fixes.time_s.len(),
+            "gnss_dropped_by_quality": job.dropped_by_quality,
             "start_time_s": res.init.nav.time_s,
-            "gnss_accepted": res.run.gnss_accepted,
-            "gnss_rejected": res.run.gnss_rejected,
-            "gnss_withheld": res.run.gnss_withheld,
+            "gnss_accepted": run.gnss_accepted,
+            "gnss_rejected": run.gnss_rejected,
+            "gnss_withheld": run.gnss_withheld,
+            "gnss_forced": run.gnss_forced,
             "horizontal_rms_m": res.horizontal_rms_m.map(|r| r.0),
+            "horizontal_rms_fixes": res.horizontal_rms_m.map(|r| r.1),
             "outages": res.outages.iter().map(|o| serde_json::json!({
                 "start_s": o.window.start_s, "end_s": o.window.end_s,
                 "end_horizontal_m": o.end_horizontal_m, "max_horizontal_m": o.max_horizontal_m,
                 "end_vertical_m": o.end_vertical_m,
             })).collect::<Vec<_>>(),
             "mean_end_horizontal_m": mean_end,
-            "outage_selection": selection,
+            "outage_selection": job.selection,
             "smoothed_outages": res.smoothed_outages.as_ref().map(|v| v.iter().map(|o| serde_json::json!({
                 "start_s": o.window.start_s, "end_s": o.window.end_s,
                 "end_horizontal_m": o.end_horizontal_m, "max_horizontal_m": o.max_horizontal_m,
             })).collect::<Vec<_>>()),
+            "notes": job.notes,
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
     println!(
-        "{} IMU epochs, {} GNSS fixes in the IMU span; filter started at {:.2} s (first fix above {} m/s)",
-        imu.len(),
-        all.fixes.time_s.len(),
+        "{} IMU epochs at {:.1} Hz ({:?}), {} GNSS fixes in the IMU span; filter started at {:.2} s",
+        job.imu.len(),
+        1.0 / job.imu.nominal_dt_s,
+        job.imu_format,
+        job.fixes.time_s.len(),
         res.init.nav.time_s,
-        cfg.min_speed_m_s
     );
     println!(
-        "GNSS: {} accepted, {} rejected by the χ² gate, {} withheld by outages",
-        res.run.gnss_accepted, res.run.gnss_rejected, res.run.gnss_withheld
+        "GNSS: {} accepted, {} rejected by the gate, {} withheld by outages, {} dropped by the quality filter",
+        run.gnss_accepted, run.gnss_rejected, run.gnss_withheld, job.dropped_by_quality
     );
     if let Some((rms, n)) = res.horizontal_rms_m {
-        println!("full-GNSS horizontal one-step prediction error: RMS {rms:.3} m over {n} fixes");
+        println!(
+            "full-GNSS horizontal one-step prediction error: RMS {rms:.3} m over {n} fixes \
+             (not counting {:.0} s after the start and {:.0} s after each outage)",
+            sc.converge_s, sc.reconverge_s
+        );
     }
-    if let Some(sel) = &selection {
+    if let Some(sel) = &job.selection {
         print!("{}", selection_table(sel));
     }
     if !res.outages.is_empty() {
         let mut t = crate::output::Table::new([
             "outage",
-            "start [s]",
-            "end [s]",
-            "end error [m]",
-            "max inside [m]",
-            "smoothed max [m]",
+            "start s [s]",
+            "end e [s]",
+            "end error¹ [m]",
+            "max inside² [m]",
+            "smoothed max² [m]",
         ]);
         for (i, o) in res.outages.iter().enumerate() {
             let sm = res
@@ -292,6 +317,11 @@ pub fn run(a: NavArgs) -> Result<()> {
             ]);
         }
         print!("{}", t.render());
+        println!(
+            "fixes withheld in (s, e]. ¹ horizontal error of the forward filter at the first fix after e \
+             (its prediction against that fix); ² largest horizontal error at the IMU epochs in (s, e] \
+             against the fixes interpolated linearly"
+        );
         if let Some(m) = mean_end {
             println!(
                 "mean end-of-outage horizontal error {m:.2} m over {} outages",
@@ -303,34 +333,6 @@ pub fn run(a: NavArgs) -> Result<()> {
         println!("KF-GINS-format outputs written to {}", dir.display());
     }
     Ok(())
-}
-
-/// `auto:NxL` outages: chosen on the GNSS fixes inside the IMU span (the drive's only
-/// reference) before any filtering, so an impossible request fails at once; returned as
-/// absolute windows. Other specifications pass through unchanged.
-fn choose_outages(
-    spec: OutageSpec,
-    fixes: &GnssFixes,
-) -> Result<(OutageSpec, Option<Vec<SelectedOutage>>)> {
-    if !matches!(spec, OutageSpec::Auto { .. }) {
-        return Ok((spec, None));
-    }
-    let reference = driftless::eval::reference::reference_from_fixes(fixes)
-        .context("--outages auto: the GNSS fixes as reference")?;
-    let sel = driftless::eval::resolve_outages(
-        &spec,
-        &reference,
-        &driftless::eval::SelectOptions::default(),
-    )
-    .context("--outages")?;
-    let items = sel
-        .iter()
-        .map(|s| OutageItem {
-            start: OutageStart::Gps(s.window.start_s),
-            length_s: s.window.duration_s(),
-        })
-        .collect();
-    Ok((OutageSpec::Windows(items), Some(sel)))
 }
 
 /// The automatically chosen windows and the dynamics inside them.
@@ -360,7 +362,7 @@ fn selection_table(sel: &[SelectedOutage]) -> String {
 fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
     let job = kf_gins_job(
         path,
-        &a.outages,
+        a.outages_spec(),
         true,
         a.csv.is_some() || a.geojson.is_some(),
     )?;

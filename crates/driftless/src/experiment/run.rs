@@ -28,8 +28,7 @@ use crate::nav::filter::run::{InitialState, run_forward};
 use crate::nav::filter::smoother::smooth;
 use crate::nav::outage::{OutageSpec, OutageWindow};
 use crate::nav::pipeline::{
-    GnssOutsideImu, ImuStream, ImuStreamOptions, TaggedCsvOptions, imu_from_kfgins,
-    imu_from_tagged_csv_files, read_gnss_file, select_gnss,
+    GnssOutsideImu, ImuStream, ImuStreamOptions, imu_from_kfgins, read_gnss_file, select_gnss,
 };
 use crate::nav::session::{SessionConfig, initialise_in_motion, prime_gyro_bias};
 use crate::sim::scenario::{ErrorTerms, ImuSpec, OutputSpec, Scenario, TrajectorySpec};
@@ -289,64 +288,67 @@ pub fn prepare(scenario: ExperimentScenario) -> Result<Prepared, ExperimentError
                 recorded: None,
             })
         }
-        VehicleSource::Drive0708 | VehicleSource::KfGins | VehicleSource::Csv => {
+        VehicleSource::NavConfig | VehicleSource::KfGins | VehicleSource::Csv => {
             let v = &scenario.vehicle;
-            let (Some(imu_rel), Some(gnss_rel)) = (&v.imu_file, &v.gnss_file) else {
-                return Err(scenario.invalid("recorded [vehicle] needs imu_file and gnss_file"));
-            };
-            let (imu_path, gnss_path) = (scenario.resolve(imu_rel), scenario.resolve(gnss_rel));
             let stage = |e: &dyn std::fmt::Display| ExperimentError::stage("vehicle", e);
-            let mut rates = None;
-            let (imu, mut session) = if source == VehicleSource::Csv {
-                let opts = crate::io::TextOptions {
-                    time_column: Some(crate::io::text::ColumnRef::Index(1)),
-                    ..crate::io::TextOptions::default()
-                };
-                let log = crate::io::read_log_file(&imu_path, &opts).map_err(|e| stage(&e))?;
-                let r = RatesWithTemperature::from_log(&log).map_err(|e| stage(&e))?;
-                if scenario.chamber.is_some() && r.temperature_c.is_none() {
-                    return Err(scenario.invalid(format!(
-                        "[chamber] model given, but {} has no temperature column (a header \
-                         field with unit [degC] or named temperature)",
-                        imu_path.display()
-                    )));
-                }
-                let imu = r
-                    .stream("raw", |_, w, f| Ok((w, f)))
+            let (imu, rates, fixes, session) = if let Some(p) = &v.nav_config {
+                let loaded = crate::nav::config::NavConfig::load(Some(&scenario.resolve(p)), &[])
                     .map_err(|e| stage(&e))?;
-                rates = Some(r);
-                let noise = crate::nav::session::consumer_mems_noise();
-                (imu, SessionConfig::new(FilterConfig::new(noise, [0.0; 3])))
-            } else if source == VehicleSource::Drive0708 {
-                let mut tag = imu_path.clone().into_os_string();
-                tag.push(".tag");
-                let imu = imu_from_tagged_csv_files(
-                    &imu_path,
-                    std::path::Path::new(&tag),
-                    &TaggedCsvOptions::drive_0708(),
-                )
-                .map_err(|e| stage(&e))?;
-                (imu, SessionConfig::drive_0708())
+                let inputs =
+                    crate::nav::job::read_nav_inputs(&loaded, &crate::io::TextOptions::default())
+                        .map_err(|e| stage(&e))?;
+                let mut session = inputs.session_config;
+                session.smooth = false;
+                (inputs.imu, None, inputs.fixes, session)
             } else {
-                let inc = crate::io::nav::read_kfgins_imu_file(&imu_path).map_err(|e| stage(&e))?;
-                let imu = imu_from_kfgins(
-                    &inc,
-                    &imu_path.display().to_string(),
-                    &ImuStreamOptions::default(),
-                )
-                .map_err(|e| stage(&e))?;
-                let noise = crate::nav::session::consumer_mems_noise();
-                (imu, SessionConfig::new(FilterConfig::new(noise, [0.0; 3])))
+                let (Some(imu_rel), Some(gnss_rel)) = (&v.imu_file, &v.gnss_file) else {
+                    return Err(scenario.invalid("recorded [vehicle] needs imu_file and gnss_file"));
+                };
+                let (imu_path, gnss_path) = (scenario.resolve(imu_rel), scenario.resolve(gnss_rel));
+                let mut rates = None;
+                let (imu, mut session) = if source == VehicleSource::Csv {
+                    let opts = crate::io::TextOptions {
+                        time_column: Some(crate::io::text::ColumnRef::Index(1)),
+                        ..crate::io::TextOptions::default()
+                    };
+                    let log = crate::io::read_log_file(&imu_path, &opts).map_err(|e| stage(&e))?;
+                    let r = RatesWithTemperature::from_log(&log).map_err(|e| stage(&e))?;
+                    if scenario.chamber.is_some() && r.temperature_c.is_none() {
+                        return Err(scenario.invalid(format!(
+                            "[chamber] model given, but {} has no temperature column (a header \
+                         field with unit [degC] or named temperature)",
+                            imu_path.display()
+                        )));
+                    }
+                    let imu = r
+                        .stream("raw", |_, w, f| Ok((w, f)))
+                        .map_err(|e| stage(&e))?;
+                    rates = Some(r);
+                    let noise = crate::nav::session::consumer_mems_noise();
+                    (imu, SessionConfig::new(FilterConfig::new(noise, [0.0; 3])))
+                } else {
+                    let inc =
+                        crate::io::nav::read_kfgins_imu_file(&imu_path).map_err(|e| stage(&e))?;
+                    let imu = imu_from_kfgins(
+                        &inc,
+                        &imu_path.display().to_string(),
+                        &ImuStreamOptions::default(),
+                    )
+                    .map_err(|e| stage(&e))?;
+                    let noise = crate::nav::session::consumer_mems_noise();
+                    (imu, SessionConfig::new(FilterConfig::new(noise, [0.0; 3])))
+                };
+                if let Some(l) = v.lever_arm_b_m {
+                    session.filter.lever_arm_b_m = l;
+                }
+                session.smooth = false;
+                let gnss = read_gnss_file(&gnss_path, &GnssReadOptions::default())
+                    .map_err(|e| stage(&e))?;
+                let fixes = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)
+                    .map_err(|e| stage(&e))?
+                    .fixes;
+                (imu, rates, fixes, session)
             };
-            if let Some(l) = v.lever_arm_b_m {
-                session.filter.lever_arm_b_m = l;
-            }
-            session.smooth = false;
-            let gnss =
-                read_gnss_file(&gnss_path, &GnssReadOptions::default()).map_err(|e| stage(&e))?;
-            let fixes = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)
-                .map_err(|e| stage(&e))?
-                .fixes;
             let reference = reference_from_fixes(&fixes).map_err(|e| stage(&e))?;
             let outages =
                 resolve_outages(&spec, &reference, &opts_for(&reference)).map_err(outage_err)?;

@@ -19,7 +19,8 @@
 //! [vehicle.trajectory]     #   (the `driftless simulate` keys)
 //! type = "profile"
 //! …
-//! # recorded: imu_file, gnss_file, format = "drive_0708" | "kf-gins", lever_arm_b_m
+//! # recorded: imu_file, gnss_file, format = "kf-gins" | "csv", lever_arm_b_m;
+//! #   or nav_config = "nav.toml" (a `driftless nav` configuration: files, mounting, noise …)
 //!
 //! [outages]
 //! spec = "auto:9x60"       # or "300+60,600+60" (s after the first reference epoch)
@@ -147,7 +148,7 @@ fn default_order() -> usize {
 }
 
 /// `[vehicle]`: simulated (`trajectory`, `gnss`, optional `temperature`) or recorded
-/// (`imu_file`, `gnss_file`, `format`).
+/// (`imu_file`, `gnss_file`, `format`, or a navigation configuration `nav_config`).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VehicleSpec {
@@ -166,12 +167,17 @@ pub struct VehicleSpec {
     /// Recorded GNSS file (RTKLIB `.pos` or KF-GINS text).
     #[serde(default)]
     pub gnss_file: Option<PathBuf>,
-    /// Recorded data format: `drive_0708` (tagged CSV + the drive's settings), `kf-gins`
-    /// (increments), or `csv` (delimited text of rates with a header naming units, the
-    /// time in GPS seconds in the first column, and optionally a temperature column — the
-    /// format `driftless simulate` writes — which allows case c with `[chamber] model`).
+    /// Recorded data format: `kf-gins` (increments), or `csv` (delimited text of rates with
+    /// a header naming units, the time in GPS seconds in the first column, and optionally a
+    /// temperature column — the format `driftless simulate` writes — which allows case c
+    /// with `[chamber] model`).
     #[serde(default)]
     pub format: Option<String>,
+    /// A `driftless nav` configuration ([`crate::nav::config`]) naming the recorded files
+    /// and everything about them (format, time offset, mounting, lever arm, noise, aids);
+    /// replaces `imu_file`, `gnss_file`, `format` and `lever_arm_b_m`.
+    #[serde(default)]
+    pub nav_config: Option<PathBuf>,
     /// IMU → antenna lever arm, body FRD, m (recorded data; simulated data use the gnss one).
     #[serde(default)]
     pub lever_arm_b_m: Option<[f64; 3]>,
@@ -295,8 +301,8 @@ impl Default for MonteCarloSettings {
 pub enum VehicleSource {
     /// Simulated from `[sensor]` and `[vehicle.trajectory]`.
     Simulated,
-    /// `drive_0708` tagged CSV.
-    Drive0708,
+    /// A navigation configuration file (`[vehicle] nav_config`).
+    NavConfig,
     /// KF-GINS increment text.
     KfGins,
     /// Delimited text of rates (and temperature), first column GPS time.
@@ -348,26 +354,7 @@ impl ExperimentScenario {
     /// (default `../shared/data`, relative to the working directory — the repository root
     /// in the README's commands), then resolved against the scenario's folder.
     pub fn resolve(&self, p: &Path) -> PathBuf {
-        let text = p.to_string_lossy();
-        let expanded;
-        let p = if text.contains("${DRIFTLESS_DATA}") {
-            let data = std::env::var_os("DRIFTLESS_DATA")
-                .map(PathBuf::from)
-                .unwrap_or_else(|| {
-                    std::env::current_dir()
-                        .unwrap_or_default()
-                        .join("../shared/data")
-                });
-            expanded = PathBuf::from(text.replace("${DRIFTLESS_DATA}", &data.to_string_lossy()));
-            expanded.as_path()
-        } else {
-            p
-        };
-        if p.is_absolute() {
-            p.to_path_buf()
-        } else {
-            self.base_dir.join(p)
-        }
+        crate::io::resolve_data_path(p, &self.base_dir)
     }
 
     fn existing(&self, key: &str, p: &Path) -> Result<PathBuf, ExperimentError> {
@@ -400,7 +387,10 @@ impl ExperimentScenario {
     pub fn vehicle_source(&self) -> Result<VehicleSource, ExperimentError> {
         let v = &self.vehicle;
         let sim = v.trajectory.is_some() || v.gnss.is_some() || v.temperature.is_some();
-        let rec = v.imu_file.is_some() || v.gnss_file.is_some() || v.format.is_some();
+        let rec = v.imu_file.is_some()
+            || v.gnss_file.is_some()
+            || v.format.is_some()
+            || v.nav_config.is_some();
         match (sim, rec) {
             (true, true) => Err(self.invalid(
                 "[vehicle]: give a simulated run (trajectory, gnss, temperature) or recorded \
@@ -411,12 +401,24 @@ impl ExperimentScenario {
                  recorded files (imu_file, gnss_file, format)",
             )),
             (true, false) => Ok(VehicleSource::Simulated),
+            (false, true) if v.nav_config.is_some() => {
+                if v.imu_file.is_some() || v.gnss_file.is_some() || v.format.is_some() || v.lever_arm_b_m.is_some() {
+                    return Err(self.invalid(
+                        "[vehicle]: nav_config names the files and their settings; drop imu_file, \
+                         gnss_file, format and lever_arm_b_m (or drop nav_config)",
+                    ));
+                }
+                Ok(VehicleSource::NavConfig)
+            }
             (false, true) => match v.format.as_deref() {
-                Some("drive_0708") => Ok(VehicleSource::Drive0708),
+                Some("drive_0708") => Err(self.invalid(
+                    "vehicle.format = \"drive_0708\": the drive's settings are a navigation \
+                     configuration now: nav_config = \"nav/drive0708.toml\" (from the examples folder)",
+                )),
                 Some("kf-gins") => Ok(VehicleSource::KfGins),
                 Some("csv") => Ok(VehicleSource::Csv),
                 Some(other) => Err(self.invalid(format!(
-                    "vehicle.format = {other:?}: expected \"drive_0708\", \"kf-gins\" or \"csv\""
+                    "vehicle.format = {other:?}: expected \"kf-gins\" or \"csv\", or give nav_config"
                 ))),
                 None => Err(self.invalid(
                     "vehicle.format is needed with recorded files: \"drive_0708\", \"kf-gins\" \
@@ -542,22 +544,18 @@ impl ExperimentScenario {
                     )));
                 }
             }
-            VehicleSource::Drive0708 | VehicleSource::KfGins | VehicleSource::Csv => {
+            VehicleSource::NavConfig | VehicleSource::KfGins | VehicleSource::Csv => {
                 let v = &self.vehicle;
-                let (Some(i), Some(g)) = (&v.imu_file, &v.gnss_file) else {
-                    return Err(self.invalid("recorded [vehicle] needs imu_file and gnss_file"));
-                };
-                self.existing("vehicle.imu_file", i)?;
-                self.existing("vehicle.gnss_file", g)?;
-                if source == VehicleSource::Drive0708 {
-                    let mut tag = self.resolve(i).into_os_string();
-                    tag.push(".tag");
-                    if !Path::new(&tag).is_file() {
-                        return Err(self.invalid(format!(
-                            "vehicle.imu_file: the time-tag file {} is missing",
-                            Path::new(&tag).display()
-                        )));
-                    }
+                if let Some(p) = &v.nav_config {
+                    let path = self.existing("vehicle.nav_config", p)?;
+                    crate::nav::config::NavConfig::load(Some(&path), &[])
+                        .map_err(|e| self.invalid(format!("vehicle.nav_config: {e}")))?;
+                } else {
+                    let (Some(i), Some(g)) = (&v.imu_file, &v.gnss_file) else {
+                        return Err(self.invalid("recorded [vehicle] needs imu_file and gnss_file"));
+                    };
+                    self.existing("vehicle.imu_file", i)?;
+                    self.existing("vehicle.gnss_file", g)?;
                 }
                 if self.monte_carlo.runs > 1 {
                     return Err(self.invalid(format!(
@@ -574,10 +572,10 @@ impl ExperimentScenario {
                              (`driftless thermal soak --out`)",
                         ));
                     }
-                    (Some(_), VehicleSource::Drive0708 | VehicleSource::KfGins) => {
+                    (Some(_), VehicleSource::NavConfig | VehicleSource::KfGins) => {
                         return Err(self.invalid(
-                            "[chamber] with recorded vehicle data: the drive_0708 and kf-gins \
-                             formats carry no sensor temperature, so a thermal model cannot be \
+                            "[chamber] with recorded vehicle data: a nav_config run and the kf-gins \
+                             format carry no sensor temperature, so a thermal model cannot be \
                              applied (case c); drop [chamber], or give the IMU as format = \
                              \"csv\" with a temperature column",
                         ));

@@ -46,6 +46,28 @@ pub use text::{
 pub use units::{TimeUnit, Unit};
 pub use write::{write_csv, write_csv_file};
 
+/// A path from a configuration or scenario file: `${DRIFTLESS_DATA}` replaced by that
+/// environment variable (default `../shared/data`, relative to the working directory —
+/// the repository root in the README's commands), then a relative path resolved against
+/// `base_dir` (the file's folder; empty for the working directory).
+pub fn resolve_data_path(p: &std::path::Path, base_dir: &std::path::Path) -> std::path::PathBuf {
+    use std::path::PathBuf;
+    let text = p.to_string_lossy();
+    let p = if text.contains("${DRIFTLESS_DATA}") {
+        let data = std::env::var_os("DRIFTLESS_DATA")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| {
+                std::env::current_dir()
+                    .unwrap_or_default()
+                    .join("../shared/data")
+            });
+        PathBuf::from(text.replace("${DRIFTLESS_DATA}", &data.to_string_lossy()))
+    } else {
+        p.to_path_buf()
+    };
+    if p.is_absolute() { p } else { base_dir.join(p) }
+}
+
 /// Reads a log file, choosing the reader by content: files starting with the `DRIFTLOG`
 /// magic are read as binary logs (`opts` is then ignored), anything else as delimited text.
 pub fn read_log_file(

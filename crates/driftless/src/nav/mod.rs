@@ -4,8 +4,10 @@
 //! Frames: navigation = local NED, body = forward-right-down, Earth = WGS-84. SI inside.
 
 pub mod attitude;
+pub mod config;
 pub mod earth;
 pub mod filter;
+pub mod job;
 pub mod mechanization;
 pub mod outage;
 pub mod pipeline;

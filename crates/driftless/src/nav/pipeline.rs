@@ -230,13 +230,6 @@ impl Mounting {
         misalignment_rpy_deg: [0.0; 3],
     };
 
-    /// The mounting the README of `drive/drive_0708` gives: (180, 0, 180) deg plus a
-    /// misalignment of (0, −6.79, 5.35) deg.
-    pub const DRIVE_0708: Mounting = Mounting {
-        rpy_deg: [180.0, 0.0, 180.0],
-        misalignment_rpy_deg: [0.0, -6.79, 5.35],
-    };
-
     fn euler(rpy_deg: [f64; 3]) -> Euler {
         Euler {
             roll_rad: rpy_deg[0].to_radians(),
@@ -658,21 +651,6 @@ pub struct TaggedCsvOptions {
     pub tick_mapping: TickMapping,
     /// Time shift, mounting, gap policy.
     pub stream: ImuStreamOptions,
-}
-
-impl TaggedCsvOptions {
-    /// The drive data's settings (README `drive/drive_0708`): time shift −0.125 s,
-    /// [`Mounting::DRIVE_0708`], the stretch tick mapping of the data's authors.
-    pub fn drive_0708() -> Self {
-        TaggedCsvOptions {
-            tick_mapping: TickMapping::Stretch,
-            stream: ImuStreamOptions {
-                time_shift_s: -0.125,
-                mounting: Mounting::DRIVE_0708,
-                ..ImuStreamOptions::default()
-            },
-        }
-    }
 }
 
 /// Column names of the tagged IMU CSV, in file order.

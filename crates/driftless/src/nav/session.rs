@@ -52,6 +52,10 @@ pub struct SessionConfig {
     pub sigma_floor_m: Option<(f64, f64)>,
     /// Also run the RTS smoother and report its errors inside the outages.
     pub smooth: bool,
+    /// Initial σ of the 12 sensor states (b_g, b_a, s_g, s_a; e.g. the turn-on bias σ of
+    /// a data sheet); `None` = the stationary Gauss–Markov σ of the noise model. A gyro
+    /// bias primed from a static start keeps its smaller σ.
+    pub initial_sensor_sigma: Option<[f64; 12]>,
 }
 
 impl SessionConfig {
@@ -66,27 +70,8 @@ impl SessionConfig {
             reconverge_s: 30.0,
             sigma_floor_m: None,
             smooth: false,
+            initial_sensor_sigma: None,
         }
-    }
-
-    /// Settings for `shared/data/drive/drive_0708` (roof-mounted car, consumer IMU):
-    /// antenna (0, −0.05, 0) m from the IMU in the vehicle frame; consumer-MEMS noise
-    /// with the white-noise terms ×10 for the vehicle's vibration; RTK σ floored at
-    /// 3 cm / 6 cm; non-holonomic constraint and standstill ZUPT/ZARU on; smoother on.
-    /// The ×10 and the floor were chosen on this drive from a 12-point grid
-    /// ({1, 3, 10}× noise × {none, 3 cm} floor × aids off/on; VALIDATION.md lists it),
-    /// so the drive figures are in-sample.
-    pub fn drive_0708() -> SessionConfig {
-        let mut n = consumer_mems_noise();
-        n.gyro_arw_rad_sqrt_s *= 10.0;
-        n.accel_vrw_m_s_sqrt_s *= 10.0;
-        let mut f = FilterConfig::new(n, [0.0, -0.05, 0.0]);
-        f.nhc = Some(super::filter::aids::NhcConfig::default());
-        f.standstill = Some(super::filter::aids::StandstillConfig::default());
-        let mut c = SessionConfig::new(f);
-        c.sigma_floor_m = Some((0.03, 0.06));
-        c.smooth = true;
-        c
     }
 }
 
@@ -330,18 +315,24 @@ pub fn initialise_in_motion(
         q_bn,
     };
     let mut sensors = SensorErrors::default();
-    let mut sigma_sensors = None;
+    let mut sigma_sensors = cfg.initial_sensor_sigma;
     if let Some(b) = primed_gyro_bias {
         sensors.gyro_bias_rad_s = b;
         let n = &cfg.filter.imu;
         // Primed from ≥ a few seconds of static data: the residual is the Earth rate plus
-        // the short-term drift; keep the other sensor states at their stationary σ.
-        let mut s = [0.0; 12];
-        for k in 0..3 {
-            s[k] = (0.05f64.to_radians()).min(n.gyro_bias.sigma);
-            s[3 + k] = n.accel_bias.sigma;
-            s[6 + k] = n.gyro_scale.sigma;
-            s[9 + k] = n.accel_scale.sigma;
+        // the short-term drift; keep the other sensor states at their initial σ.
+        let mut s = cfg.initial_sensor_sigma.unwrap_or_else(|| {
+            let mut s = [0.0; 12];
+            for k in 0..3 {
+                s[k] = n.gyro_bias.sigma;
+                s[3 + k] = n.accel_bias.sigma;
+                s[6 + k] = n.gyro_scale.sigma;
+                s[9 + k] = n.accel_scale.sigma;
+            }
+            s
+        });
+        for v in &mut s[..3] {
+            *v = (0.05f64.to_radians()).min(n.gyro_bias.sigma);
         }
         sigma_sensors = Some(s);
     }

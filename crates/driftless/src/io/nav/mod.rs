@@ -46,6 +46,31 @@ pub(crate) fn read_file(path: &std::path::Path) -> Result<Vec<u8>, LogError> {
     })
 }
 
+/// A small text file (a configuration) read whole, refused when larger than `max_bytes`,
+/// not UTF-8 or binary (a NUL byte), with a message that says which.
+pub(crate) fn read_text_capped(path: &std::path::Path, max_bytes: u64) -> Result<String, String> {
+    use std::io::Read;
+    let f = std::fs::File::open(path).map_err(|e| format!("cannot open: {e}"))?;
+    let mut bytes = Vec::new();
+    f.take(max_bytes + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read: {e}"))?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(format!(
+            "larger than {max_bytes} bytes: not a configuration file (binary data or a log?)"
+        ));
+    }
+    if bytes.contains(&0) {
+        return Err("binary data (a NUL byte), not a text configuration".into());
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        format!(
+            "not UTF-8 text (first bad byte at offset {}): not a configuration file",
+            e.utf8_error().valid_up_to()
+        )
+    })
+}
+
 /// Text of a file as UTF-8, or an error naming the first bad byte's line and column.
 pub(crate) fn as_utf8<'a>(bytes: &'a [u8], name: &str) -> Result<&'a str, LogError> {
     std::str::from_utf8(bytes).map_err(|e| {

@@ -1,0 +1,423 @@
+//! One navigation job from a [`crate::nav::config`] configuration: read the IMU and GNSS
+//! files it names, build the filter and session settings, choose the outages, run
+//! [`crate::nav::session::run_session`]. The CLI's `driftless nav` is this call plus
+//! printing.
+
+use std::path::{Path, PathBuf};
+
+use crate::eval::SelectedOutage;
+use crate::io::TextOptions;
+use crate::io::nav::GnssFixes;
+use crate::io::nav::kfgins::GnssReadOptions;
+use crate::nav::config::{ConfigError, KeyError, LoadedConfig};
+use crate::nav::filter::aids::{NhcConfig, StandstillConfig};
+use crate::nav::filter::model::{FilterConfig, ImuNoise};
+use crate::nav::outage::{OutageItem, OutageSpec, OutageStart};
+use crate::nav::pipeline::{
+    GnssOutsideImu, ImuStream, PipelineError, RateChannels, TaggedCsvOptions, imu_from_kfgins,
+    imu_from_rates_log, imu_from_tagged_csv_files, read_gnss_file, select_gnss, subset_fixes,
+};
+use crate::nav::session::{SessionConfig, SessionResult, run_session};
+
+/// Why a job could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum NavJobError {
+    /// A configuration value (located).
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// An input file or its timing.
+    #[error(transparent)]
+    Input(#[from] PipelineError),
+    /// Reading a log (the CSV path).
+    #[error(transparent)]
+    Read(#[from] crate::io::LogError),
+    /// The calibration model file.
+    #[error(transparent)]
+    Calibration(#[from] crate::calib::model_file::ModelFileError),
+    /// The noise model file.
+    #[error(transparent)]
+    NoiseModel(#[from] crate::allan::noise_model::NoiseModelError),
+    /// Choosing the outages.
+    #[error("outages: {0}")]
+    Outages(#[from] crate::eval::EvalError),
+    /// The filter or the session.
+    #[error(transparent)]
+    Nav(#[from] crate::nav::filter::NavError),
+}
+
+/// The IMU reader a job uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImuFormat {
+    /// KF-GINS increments.
+    Kfgins,
+    /// RTKLIB-tagged CSV with a `.tag` file.
+    TaggedCsv,
+    /// Delimited text of rates with units.
+    Csv,
+}
+
+/// What a job produced.
+#[derive(Debug)]
+pub struct NavJobResult {
+    /// The IMU stream navigated (after time offset and mounting).
+    pub imu: ImuStream,
+    /// The IMU reader used.
+    pub imu_format: ImuFormat,
+    /// GNSS fixes inside the IMU span that passed the quality filter.
+    pub fixes: GnssFixes,
+    /// Fixes dropped by the quality filter.
+    pub dropped_by_quality: usize,
+    /// The session's result.
+    pub session: SessionResult,
+    /// The settings used.
+    pub session_config: SessionConfig,
+    /// Automatically chosen outages with their dynamics (`auto:` specifications).
+    pub selection: Option<Vec<SelectedOutage>>,
+    /// What the readers and the job noted (skipped records, bridged gaps, settings taken
+    /// from the data).
+    pub notes: Vec<String>,
+}
+
+fn located(cfg: &LoadedConfig, key: &str, message: String) -> NavJobError {
+    NavJobError::Config(cfg.error(KeyError {
+        key: key.into(),
+        message,
+    }))
+}
+
+fn required(
+    cfg: &LoadedConfig,
+    key: &str,
+    v: &Option<PathBuf>,
+    what: &str,
+) -> Result<PathBuf, NavJobError> {
+    match v {
+        Some(p) => {
+            let p = cfg.path(key, p);
+            if p.is_file() {
+                Ok(p)
+            } else {
+                Err(located(cfg, key, format!("{}: no such file", p.display())))
+            }
+        }
+        None => Err(NavJobError::Config(ConfigError {
+            location: cfg.locate(key),
+            message: format!(
+                "no {what} file: set `{key}` in the configuration or pass --{}",
+                crate::nav::config::key_by_path(key).map_or("?", |k| k.flag)
+            ),
+        })),
+    }
+}
+
+/// The IMU format: as configured, or detected (`auto`): a tag file given or `FILE.tag`
+/// beside the log → tagged CSV; a first line with a non-numeric field (a header) → rates
+/// CSV; otherwise KF-GINS increments.
+pub fn detect_imu_format(format: &str, file: &Path, tag_given: bool) -> ImuFormat {
+    match format {
+        "kfgins" => ImuFormat::Kfgins,
+        "tagged-csv" => ImuFormat::TaggedCsv,
+        "csv" => ImuFormat::Csv,
+        _ => {
+            if tag_given || default_tag(file).is_file() {
+                return ImuFormat::TaggedCsv;
+            }
+            let head = std::fs::File::open(file).ok().and_then(|f| {
+                use std::io::{BufRead, BufReader, Read};
+                let mut line = String::new();
+                BufReader::new(f.take(64 * 1024))
+                    .read_line(&mut line)
+                    .ok()?;
+                Some(line)
+            });
+            let header = head.is_some_and(|l| {
+                l.split([',', ' ', '\t', ';'])
+                    .map(str::trim)
+                    .filter(|f| !f.is_empty())
+                    .any(|f| f.parse::<f64>().is_err())
+            });
+            if header {
+                ImuFormat::Csv
+            } else {
+                ImuFormat::Kfgins
+            }
+        }
+    }
+}
+
+fn default_tag(file: &Path) -> PathBuf {
+    let mut p = file.as_os_str().to_owned();
+    p.push(".tag");
+    PathBuf::from(p)
+}
+
+/// The session settings of a configuration with its noise model (no file access).
+pub fn session_config(
+    cfg: &LoadedConfig,
+    noise: ImuNoise,
+    initial_sensor_sigma: [f64; 12],
+) -> Result<SessionConfig, NavJobError> {
+    let c = &cfg.config;
+    let mut f = FilterConfig::new(noise, c.gnss.lever_arm_m);
+    f.chi2_gate = c
+        .gate_threshold()
+        .map_err(|e| NavJobError::Config(cfg.error(e)))?;
+    f.quality_scale = c.quality_scale();
+    f.use_gnss_velocity = c.gnss.use_velocity;
+    let a = &c.aids;
+    if a.nhc {
+        let d = NhcConfig::default();
+        f.nhc = Some(NhcConfig {
+            sigma_m_s: [a.nhc_sigma_m_s; 2],
+            min_speed_m_s: a.nhc_min_speed_m_s,
+            max_yaw_rate_rad_s: a.nhc_max_yaw_rate_deg_s.to_radians(),
+            ..d
+        });
+    }
+    if a.zupt {
+        let d = StandstillConfig::default();
+        f.standstill = Some(StandstillConfig {
+            window_s: a.standstill_window_s,
+            min_duration_s: a.standstill_min_s,
+            accel_std_max_m_s2: a.standstill_accel_std_m_s2,
+            gyro_std_max_rad_s: a.standstill_gyro_std_deg_s.to_radians(),
+            max_speed_m_s: Some(a.standstill_max_speed_m_s),
+            zupt_sigma_m_s: Some(a.zupt_sigma_m_s),
+            zaru_sigma_rad_s: Some(a.zaru_sigma_deg_s.to_radians()),
+            ..d
+        });
+    }
+    let mut s = SessionConfig::new(f);
+    s.min_speed_m_s = c.align.min_speed_m_s;
+    s.static_prime_s = c.align.static_s;
+    s.converge_s = c.outages.converge_s;
+    s.reconverge_s = c.outages.reconverge_s;
+    s.sigma_floor_m = c.sigma_floor_m();
+    s.smooth = c.filter.smooth;
+    s.initial_sensor_sigma = Some(initial_sensor_sigma);
+    Ok(s)
+}
+
+/// The inputs of a job, read and checked: the IMU stream, the fixes, the settings.
+#[derive(Debug)]
+pub struct NavInputs {
+    /// The IMU stream (after time offset, mounting and calibration).
+    pub imu: ImuStream,
+    /// The IMU reader used.
+    pub imu_format: ImuFormat,
+    /// GNSS fixes inside the IMU span that passed the quality filter.
+    pub fixes: GnssFixes,
+    /// Fixes dropped by the quality filter.
+    pub dropped_by_quality: usize,
+    /// The session settings (no outages yet).
+    pub session_config: SessionConfig,
+    /// The outage specification.
+    pub outages: OutageSpec,
+    /// What the readers noted.
+    pub notes: Vec<String>,
+}
+
+/// Runs the job of `cfg`: [`read_nav_inputs`], the outages, [`run_session`].
+pub fn run_nav_job(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavJobResult, NavJobError> {
+    let NavInputs {
+        imu,
+        imu_format,
+        fixes,
+        dropped_by_quality,
+        mut session_config,
+        outages,
+        notes,
+    } = read_nav_inputs(cfg, csv)?;
+    let (spec, selection) = choose_outages(outages, &fixes)?;
+    session_config.outages = select_gnss(&fixes, &imu, &spec, GnssOutsideImu::Drop)?.windows;
+    let session = run_session(&imu, &fixes, &session_config)?;
+    Ok(NavJobResult {
+        imu,
+        imu_format,
+        fixes,
+        dropped_by_quality,
+        session,
+        session_config,
+        selection,
+        notes,
+    })
+}
+
+/// Reads the files of `cfg` and builds the settings. `csv` says how to read a rates CSV
+/// (`imu.format = "csv"`): columns, units, time column. Everything that needs no data
+/// file (noise values, the outage specification, the calibration file) is checked before
+/// the data are read.
+pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInputs, NavJobError> {
+    let c = &cfg.config;
+    let imu_path = required(cfg, "imu.file", &c.imu.file, "IMU")?;
+    let gnss_path = required(cfg, "gnss.file", &c.gnss.file, "GNSS")?;
+    let tag = c.imu.tag.as_ref().map(|t| cfg.path("imu.tag", t));
+    let format = detect_imu_format(&c.imu.format, &imu_path, tag.is_some());
+    let mut notes = Vec::new();
+    // Everything that needs no data file is checked before the data are read.
+    let model = match &c.noise.model {
+        Some(p) => Some(crate::allan::noise_model::NoiseModel::load(
+            &cfg.path("noise.model", p),
+        )?),
+        None => None,
+    };
+    let (noise, sigma0) = c
+        .noise_settings(model.as_ref())
+        .map_err(|e| NavJobError::Config(cfg.error(e)))?;
+    let spec: OutageSpec =
+        c.outages
+            .spec
+            .parse()
+            .map_err(|e: crate::nav::outage::OutageError| {
+                located(cfg, "outages.spec", e.to_string())
+            })?;
+    let calibration = match &c.imu.calibration {
+        Some(p) => {
+            let path = cfg.path("imu.calibration", p);
+            let f = crate::calib::model_file::CalibrationFile::load(&path)?;
+            for (t, si) in [(&f.accel, ["m/s^2", "m/s²"]), (&f.gyro, ["rad/s", "rad/s"])] {
+                if !si.contains(&t.raw_unit.as_str()) {
+                    return Err(located(
+                        cfg,
+                        "imu.calibration",
+                        format!(
+                            "{}: raw unit {:?}: navigation reads SI samples, so it can apply only a calibration of SI samples ({} / rad/s)",
+                            path.display(),
+                            t.raw_unit,
+                            si[0]
+                        ),
+                    ));
+                }
+            }
+            Some(f.calibration())
+        }
+        None => None,
+    };
+    let opts = c.stream_options();
+    let mut imu = match format {
+        ImuFormat::Kfgins => {
+            let inc = crate::io::nav::read_kfgins_imu_file(&imu_path)?;
+            imu_from_kfgins(&inc, &imu_path.display().to_string(), &opts)?
+        }
+        ImuFormat::TaggedCsv => {
+            let tag = tag.unwrap_or_else(|| default_tag(&imu_path));
+            if !tag.is_file() {
+                return Err(located(
+                    cfg,
+                    "imu.tag",
+                    format!(
+                        "{}: no such tag file; a tagged CSV needs its RTKLIB .tag (pass --tag)",
+                        tag.display()
+                    ),
+                ));
+            }
+            imu_from_tagged_csv_files(
+                &imu_path,
+                &tag,
+                &TaggedCsvOptions {
+                    stream: opts,
+                    ..TaggedCsvOptions::default()
+                },
+            )?
+        }
+        ImuFormat::Csv => {
+            let log = crate::io::read_log_file(&imu_path, csv)?;
+            imu_from_rates_log(&log, &RateChannels::ByQuantity, &opts)?
+        }
+    };
+    for g in imu.gaps.iter().take(20) {
+        notes.push(format!(
+            "{}: IMU gap of {:.4} s before t = {:.4} s: integrated across",
+            imu_path.display(),
+            g.gap_s,
+            g.time_s
+        ));
+    }
+    if imu.gaps.len() > 20 {
+        notes.push(format!("… {} more IMU gaps", imu.gaps.len() - 20));
+    }
+    if let Some(r) = c.imu.rate_hz {
+        let measured = 1.0 / median_interval(&imu);
+        if (measured - r).abs() > 0.05 * r {
+            notes.push(format!(
+                "imu.rate_hz = {r} Hz but the time stamps run at {measured:.1} Hz: the time stamps are integrated as they are"
+            ));
+        }
+    }
+    if let Some(cal) = &calibration {
+        imu.apply_calibration(cal);
+    }
+    let gnss = read_gnss_file(&gnss_path, &GnssReadOptions::default())?;
+    let all = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)?;
+    let accepted = c.accepted_qualities();
+    let keep: Vec<bool> = all
+        .fixes
+        .quality
+        .iter()
+        .map(|&q| accepted.get(q as usize).copied().unwrap_or(false))
+        .collect();
+    let dropped = keep.iter().filter(|k| !**k).count();
+    let fixes = if dropped > 0 {
+        subset_fixes(&all.fixes, &keep)
+    } else {
+        all.fixes
+    };
+    if fixes.is_empty() {
+        return Err(located(
+            cfg,
+            "gnss.accept",
+            format!(
+                "{}: no GNSS fix inside the IMU span passes the quality filter ({} dropped)",
+                gnss_path.display(),
+                dropped
+            ),
+        ));
+    }
+    let session_config = session_config(cfg, noise, sigma0)?;
+    Ok(NavInputs {
+        imu,
+        imu_format: format,
+        fixes,
+        dropped_by_quality: dropped,
+        session_config,
+        outages: spec,
+        notes,
+    })
+}
+
+fn median_interval(imu: &ImuStream) -> f64 {
+    let mut d: Vec<f64> = imu
+        .epochs
+        .iter()
+        .map(|e| e.dt_s)
+        .filter(|d| *d > 0.0)
+        .collect();
+    if d.is_empty() {
+        return f64::NAN;
+    }
+    d.sort_by(f64::total_cmp);
+    d[d.len() / 2]
+}
+
+/// `auto:NxL` outages: chosen on the GNSS fixes inside the IMU span (the only reference of
+/// a recorded run) before any filtering, so an impossible request fails at once; returned
+/// as absolute windows. Other specifications pass through unchanged.
+pub fn choose_outages(
+    spec: OutageSpec,
+    fixes: &GnssFixes,
+) -> Result<(OutageSpec, Option<Vec<SelectedOutage>>), NavJobError> {
+    if !matches!(spec, OutageSpec::Auto { .. }) {
+        return Ok((spec, None));
+    }
+    let reference = crate::eval::reference::reference_from_fixes(fixes)?;
+    let sel =
+        crate::eval::resolve_outages(&spec, &reference, &crate::eval::SelectOptions::default())?;
+    let items = sel
+        .iter()
+        .map(|s| OutageItem {
+            start: OutageStart::Gps(s.window.start_s),
+            length_s: s.window.duration_s(),
+        })
+        .collect();
+    Ok((OutageSpec::Windows(items), Some(sel)))
+}
