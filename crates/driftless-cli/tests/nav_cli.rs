@@ -140,13 +140,11 @@ fn kf_gins_config_runs_unchanged_and_writes_its_three_files() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `driftless nav --imu-format csv`: a generic CSV of rates (units from the header) with
-/// KF-GINS GNSS; the filter initialises in motion from the fixes and follows the turn.
-#[test]
-fn generic_rate_csv_runs() {
+/// The turn as a rates CSV (`imu.csv`, units in the header, GPS time first) and KF-GINS
+/// GNSS (`gnss.txt`) in `dir`.
+fn write_turn_csv(dir: &std::path::Path) {
     use std::fmt::Write as _;
-    let dir = std::env::temp_dir().join(format!("driftless-navcsv-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::create_dir_all(dir).unwrap();
     let t0 = 356_400.0;
     let turn = turn();
     let dt = 0.005;
@@ -178,6 +176,105 @@ fn generic_rate_csv_runs() {
         &turn_fixes(&turn, t0),
     )
     .unwrap();
+}
+
+/// The navigation configuration: `--print-config` reads back; a file gives the same run as
+/// the flags; relative paths resolve against the file's folder; bad values name the file,
+/// line and column or the flag; outages longer than the data are refused.
+#[test]
+fn configuration_file_and_flags() {
+    let dir = std::env::temp_dir().join(format!("driftless-navconf-{}", std::process::id()));
+    write_turn_csv(&dir);
+    let run = |args: &[&str]| bin().current_dir(&dir).args(args).output().unwrap();
+    let printed = run(&["nav", "--print-config"]);
+    assert!(printed.status.success());
+    let text = String::from_utf8(printed.stdout).unwrap();
+    assert!(
+        text.contains("[imu]") && text.contains("(--gate)"),
+        "{text}"
+    );
+    // The printed default plus the files, in a sub-folder: paths relative to it.
+    std::fs::create_dir_all(dir.join("conf")).unwrap();
+    let conf = text
+        .replace("# file = \"imu.txt\"", "file = \"../imu.csv\"")
+        .replace("# file = \"gnss.pos\"", "file = \"../gnss.txt\"")
+        .replace("format = \"auto\"", "format = \"csv\"");
+    std::fs::write(dir.join("conf/nav.toml"), conf).unwrap();
+    let a = run(&[
+        "nav",
+        "--config",
+        "conf/nav.toml",
+        "--outages",
+        "60+20",
+        "--json",
+    ]);
+    assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    let b = run(&[
+        "nav",
+        "--imu",
+        "imu.csv",
+        "--imu-format",
+        "csv",
+        "--gnss",
+        "gnss.txt",
+        "--outages",
+        "60+20",
+        "--json",
+    ]);
+    assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
+    let (va, vb): (serde_json::Value, serde_json::Value) = (
+        serde_json::from_slice(&a.stdout).unwrap(),
+        serde_json::from_slice(&b.stdout).unwrap(),
+    );
+    assert_eq!(va["outages"], vb["outages"]);
+    assert_eq!(va["horizontal_rms_m"], vb["horizontal_rms_m"]);
+    // A bad value in the file.
+    std::fs::write(
+        dir.join("bad.toml"),
+        "[imu]\nfile = \"imu.csv\"\n\n[gnss]\nsigma_floor_m = -0.1\n",
+    )
+    .unwrap();
+    let e = run(&["nav", "--config", "bad.toml"]);
+    let msg = String::from_utf8_lossy(&e.stderr);
+    assert!(!e.status.success());
+    assert!(
+        msg.contains("bad.toml:5:17 (key `gnss.sigma_floor_m`)") && msg.contains("≥ 0"),
+        "{msg}"
+    );
+    // The same from a flag; an unknown quality name; a mounting in radians by mistake.
+    for (args, want) in [
+        (vec!["--gnss-sigma-floor", "-1"], "flag --gnss-sigma-floor"),
+        (vec!["--gnss-accept", "fix,fixed"], "not a solution quality"),
+        (vec!["--mounting-rpy-deg", "3.14,0,1000"], "±360"),
+        (vec!["--gate", "chi2:1.5"], "0 < P < 1"),
+        (vec!["--outages", "100+60"], "outage"),
+    ] {
+        let mut all = vec![
+            "nav",
+            "--imu",
+            "imu.csv",
+            "--imu-format",
+            "csv",
+            "--gnss",
+            "gnss.txt",
+        ];
+        all.extend(args.iter().copied());
+        let e = run(&all);
+        let msg = String::from_utf8_lossy(&e.stderr);
+        assert!(!e.status.success(), "{args:?} succeeded");
+        assert!(msg.contains(want), "{args:?}: {msg}");
+        assert!(!msg.contains("panicked"), "{msg}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `driftless nav --imu-format csv`: a generic CSV of rates (units from the header) with
+/// KF-GINS GNSS; the filter initialises in motion from the fixes and follows the turn.
+#[test]
+fn generic_rate_csv_runs() {
+    use std::fmt::Write as _;
+    let dir = std::env::temp_dir().join(format!("driftless-navcsv-{}", std::process::id()));
+    write_turn_csv(&dir);
     let out = bin()
         .current_dir(&dir)
         .args([
