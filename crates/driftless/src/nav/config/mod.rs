@@ -666,6 +666,15 @@ impl NavConfig {
                 ),
             ));
         }
+        if i.tag.is_some() && !["auto", "tagged-csv"].contains(&i.format.as_str()) {
+            return Err(key_err(
+                "imu.tag",
+                format!(
+                    "a time-tag file goes with the tagged-CSV reader, but imu.format = {:?}: drop the tag or set format tagged-csv (or auto)",
+                    i.format
+                ),
+            ));
+        }
         if !i.time_offset_s.is_finite() || i.time_offset_s.abs() > 86_400.0 {
             return Err(key_err(
                 "imu.time_offset_s",
