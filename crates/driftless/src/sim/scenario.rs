@@ -35,8 +35,8 @@
 //!
 //! Trajectory kinds: `recorded` ([`super::recorded`]: `file`, optional
 //! `position_cutoff_hz`, `roll = "zero" | "coordinated_turn"`), `profile`
-//! ([`super::profile`]: `file`, or the profile's `[start]`/`[mounting]`/`[[segment]]`
-//! inline under `[trajectory]`), `static` (`lat_deg`, `lon_deg`, `height_m`, `roll_deg`,
+//! ([`super::profile`]: `file`, or the profile's `[start]`/`[mounting]`/`[gait]`/
+//! `[[segment]]` inline under `[trajectory]`), `static` (`lat_deg`, `lon_deg`, `height_m`, `roll_deg`,
 //! `pitch_deg`, `yaw_deg`, `duration_s`) and `chamber` ([`super::chamber::ChamberConfig`]
 //! keys; its sample rate is `imu.rate_hz`). Relative paths resolve against the
 //! scenario file's folder. Unknown keys anywhere are errors naming the key.
@@ -166,6 +166,9 @@ pub enum TrajectorySpec {
         /// Inline `[mounting]`.
         #[serde(default)]
         mounting: Option<toml::Value>,
+        /// Inline `[gait]` (a hand-held walk).
+        #[serde(default)]
+        gait: Option<toml::Value>,
         /// Inline `[[segment]]`s.
         #[serde(default)]
         segment: Option<Vec<toml::Value>>,
@@ -453,6 +456,7 @@ impl Scenario {
                 file,
                 start,
                 mounting,
+                gait,
                 segment,
             } => {
                 let profile = match (file, start) {
@@ -463,6 +467,9 @@ impl Scenario {
                         t.insert("start".into(), start.clone());
                         if let Some(m) = mounting {
                             t.insert("mounting".into(), m.clone());
+                        }
+                        if let Some(g) = gait {
+                            t.insert("gait".into(), g.clone());
                         }
                         t.insert(
                             "segment".into(),
