@@ -31,6 +31,15 @@
 //! sigma_ned_m = [0.02, 0.02, 0.02]
 //! lever_arm_b_m = [0.0, 0.0, -1.0]
 //! outages = "9x60s every 300s from 300s"   # fixes removed from the output
+//! # correlated_sigma_ned_m = [0.2, 0.2, 0.1]  # Gauss–Markov error (antenna motion)
+//! # correlated_tau_s = 3.0
+//! # reported_sigma_ned_m = [0.01, 0.01, 0.02] # the receiver's formal σ in the files
+//! # [[gnss.degraded_windows]]                 # e.g. RTK float, s from the first fix
+//! # start_s = 60.0
+//! # end_s = 80.0
+//! # sigma_ned_m = [0.4, 0.4, 0.8]             # extra Gauss–Markov error
+//! # tau_s = 20.0
+//! # reported_sigma_ned_m = [0.15, 0.15, 0.3]
 //! ```
 //!
 //! Trajectory kinds: `recorded` ([`super::recorded`]: `file`, optional
@@ -223,6 +232,13 @@ pub struct GnssSpec {
     /// RTKLIB quality flag.
     #[serde(default)]
     pub quality: Option<u8>,
+    /// σ written with the fixes (the receiver's formal σ), m; default the true total σ.
+    #[serde(default)]
+    pub reported_sigma_ned_m: Option<[f64; 3]>,
+    /// Degraded (e.g. RTK float) windows, times relative to the first fix
+    /// ([`super::gnss::DegradedWindow`]).
+    #[serde(default)]
+    pub degraded_windows: Vec<super::gnss::DegradedWindow>,
     /// Outage windows (fixes removed), `--outages` grammar.
     #[serde(default)]
     pub outages: Option<String>,
@@ -596,6 +612,16 @@ impl Scenario {
             if let Some(q) = g.quality {
                 cfg.quality = q;
             }
+            cfg.reported_sigma_ned_m = g.reported_sigma_ned_m;
+            cfg.degraded_windows = g
+                .degraded_windows
+                .iter()
+                .map(|w| super::gnss::DegradedWindow {
+                    start_s: w.start_s + t0,
+                    end_s: w.end_s + t0,
+                    ..w.clone()
+                })
+                .collect();
             cfg.time_offset_s = offset;
             cfg.gps_week = self.gps_week;
             // The first fix is at t0 (the start of the trajectory); 1 s margin at the end.
