@@ -44,12 +44,34 @@
 //!     not bad luck. Bar: ≥ 90 % of windows for each length. Reported alongside:
 //!     mean e_h, mean bound, and the mean of e_h²/(σ_N² + σ_E²) (≈ 1 when consistent).
 //!
-//! **Measured with today's filter** (release, 2 cores: ≈ 40 s for the three variants ×
-//! 20 seeds × 3 runs): see the table in VALIDATION.md and the report printed by
-//! `cargo test --release -p driftless --test nav_walk -- --ignored --nocapture`.
-//! Today's filter does not meet the bars (the table), so the asserting test is ignored
-//! until the filter gets σ inflation instead of rejection as its default gate and an
-//! alignment that works at walking speed.
+//! **Measured with today's filter** (release, 2 cores: 1.3 s to simulate the 20 walks,
+//! 2–3 s per variant for 20 seeds × 3 runs; `cargo test --release -p driftless --test
+//! nav_walk measure_ -- --ignored --nocapture`, with `WALK_DIAGNOSTICS=1` for D–H):
+//!
+//! | variant | (a) rejected | (b) one-step / fix RMS (worst seed) | (c) 15 s: covered, mean e_h, mean 3σ_h | (c) 30 s: covered, mean e_h, mean 3σ_h | initial heading error RMS |
+//! |---|---|---|---|---|---|
+//! | A default χ² gate | 81.5 % (696 forced) | 2.04 / 0.361 m = 5.67 (35.6) | 20.0 %, 52.6 m, 15.8 m | 25.0 %, 196 m, 58.4 m | 47.8° |
+//! | B σ floor 0.1 / 0.2 m | 12.2 % | 0.895 / 0.361 m = 2.48 (19.9) | 72.5 %, 25.3 m, 12.9 m | 70.0 %, 77.4 m, 43.3 m | 47.8° |
+//! | C no gate | 0 % | 0.876 / 0.361 m = 2.43 (8.8) | 11.2 %, 25.0 m, 5.9 m | 15.0 %, 81.8 m, 21.1 m | 47.8° |
+//! | D σ floor 0.3 / 0.3 m | 8.8 % | 1.114 / 0.361 m = 3.09 (19.2) | 82.5 %, 27.3 m, 20.4 m | 81.7 %, 80.5 m, 68.6 m | 47.8° |
+//! | E = A, antenna rigid on its lever arm | 4.7 % | 0.254 / 0.234 m = 1.09 (6.1) | 92.5 %, 3.7 m, 6.3 m | 91.7 %, 19.5 m, 21.8 m | 1.4° |
+//! | F = D, IMU noise terms only | 7.0 % | 1.232 / 0.361 m = 3.42 (19.3) | 90.0 %, 18.1 m, 19.8 m | 86.7 %, 55.9 m, 66.4 m | 47.8° |
+//! | G = D, true initial attitude and velocity | 2.3 % | 0.453 / 0.361 m = 1.26 (5.0) | 91.2 %, 15.7 m, 19.5 m | 91.7 %, 46.7 m, 66.0 m | 0 |
+//! | H = A, true initial attitude and velocity | 80.0 % | 0.950 / 0.361 m = 2.63 (8.4) | 28.7 %, 37.0 m, 16.1 m | 30.0 %, 140 m, 58.5 m | 0 |
+//!
+//! (The fix RMS of E is the float stretch's and the 5-mm white error: its antenna does
+//! not move.) Reading: no variant of today's filter meets all three bars. Two things
+//! break it, each visible on its own: (1) the initial heading — from the central
+//! difference of fixes whose antenna moves by decimetres, at 0.8 m/s, it is wrong by
+//! 48° RMS (1.4° with a rigid antenna), and every variant started there misses (c);
+//! (2) the 1-cm formal σ against 0.28-m antenna motion — the χ² gate then rejects 80 %
+//! of the fixes even from the true attitude (H), while a σ floor at the motion's σ with
+//! the true attitude (G) comes close to every bar (a 2.3 %, b 1.26×, c 91 / 92 %).
+//! Free-inertial drift of this consumer IMU without aids is tens of metres in 30 s
+//! (E: 19.5 m with a rigid antenna), so (c) is a consistency bar, not an accuracy one.
+//! Today's filter does not meet the bars, so the asserting test is ignored until the
+//! filter has σ inflation instead of rejection as its default gate and an alignment
+//! that works at walking speed.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -57,11 +79,13 @@ use std::time::Instant;
 use driftless::io::nav::{NavSolution, quality};
 use driftless::nav::attitude::Euler;
 use driftless::nav::earth::ned_offset_m;
-use driftless::nav::filter::{FilterConfig, GaussMarkov, ImuNoise};
+use driftless::nav::filter::{
+    FilterConfig, ForwardRun, GaussMarkov, ImuNoise, UpdateKind, run_forward,
+};
 use driftless::nav::mechanization::mechanize;
 use driftless::nav::outage::OutageWindow;
 use driftless::nav::pipeline::ImuStream;
-use driftless::nav::session::{SessionConfig, run_session};
+use driftless::nav::session::{SessionConfig, initialise_in_motion, prime_gyro_bias, run_session};
 use driftless::sim::presets::Preset;
 use driftless::sim::scenario::{ErrorTerms, Scenario, Simulation};
 
@@ -126,22 +150,47 @@ fn walk_noise() -> ImuNoise {
     }
 }
 
-/// The filter variants of the study.
-#[derive(Clone, Copy, Debug)]
+/// The filter variants of the study (A–C), and diagnostics (D–G) that tell which
+/// part of the problem limits today's filter.
+#[derive(Clone, Copy, Debug, PartialEq)]
 enum Variant {
     Chi2Gate,
     SigmaFloor,
     NoGate,
+    /// σ floored at the antenna motion's own horizontal σ per axis (0.3 m / 0.3 m).
+    FloorAtMotion,
+    /// The antenna rigidly on its lever arm (no antenna motion; file σ 1 cm), default gate.
+    RigidAntenna,
+    /// D on a walk whose IMU has only the preset's noise terms (no turn-on bias, scale
+    /// factor, misalignment, g-sensitivity).
+    FloorAtMotionNoiseOnly,
+    /// D started from the session's initial state with the true attitude and velocity
+    /// (what a working walking-speed alignment would give).
+    FloorAtMotionTrueHeading,
+    /// The default χ² gate started like G.
+    Chi2GateTrueHeading,
 }
 
 impl Variant {
-    const ALL: [Variant; 3] = [Variant::Chi2Gate, Variant::SigmaFloor, Variant::NoGate];
+    const STUDY: [Variant; 3] = [Variant::Chi2Gate, Variant::SigmaFloor, Variant::NoGate];
+    const DIAGNOSTICS: [Variant; 5] = [
+        Variant::FloorAtMotion,
+        Variant::RigidAntenna,
+        Variant::FloorAtMotionNoiseOnly,
+        Variant::FloorAtMotionTrueHeading,
+        Variant::Chi2GateTrueHeading,
+    ];
 
     fn label(self) -> &'static str {
         match self {
             Variant::Chi2Gate => "A default χ² gate",
             Variant::SigmaFloor => "B σ floor 0.1/0.2 m",
             Variant::NoGate => "C no gate",
+            Variant::FloorAtMotion => "D σ floor 0.3/0.3 m",
+            Variant::RigidAntenna => "E rigid antenna, χ² gate",
+            Variant::FloorAtMotionNoiseOnly => "F = D, IMU noise terms only",
+            Variant::FloorAtMotionTrueHeading => "G = D, true initial attitude",
+            Variant::Chi2GateTrueHeading => "H = A, true initial attitude",
         }
     }
 
@@ -149,11 +198,28 @@ impl Variant {
         let mut c = SessionConfig::new(FilterConfig::new(walk_noise(), lever_b_m));
         c.min_speed_m_s = MIN_SPEED_M_S;
         match self {
-            Variant::Chi2Gate => {}
+            Variant::Chi2Gate | Variant::RigidAntenna | Variant::Chi2GateTrueHeading => {}
             Variant::SigmaFloor => c.sigma_floor_m = Some((0.1, 0.2)),
             Variant::NoGate => c.filter.chi2_gate = None,
+            Variant::FloorAtMotion
+            | Variant::FloorAtMotionNoiseOnly
+            | Variant::FloorAtMotionTrueHeading => c.sigma_floor_m = Some((0.3, 0.3)),
         }
         c
+    }
+
+    /// The walk of this variant for a seed.
+    fn walk(self, seed: u64) -> Simulation {
+        let mut s = scenario();
+        s.seed = seed;
+        match self {
+            Variant::RigidAntenna => {
+                s.gnss.as_mut().expect("[gnss]").correlated_sigma_ned_m = [0.0; 3];
+            }
+            Variant::FloorAtMotionNoiseOnly => s.imu.errors = ErrorTerms::Noise,
+            _ => {}
+        }
+        s.run().expect("walk simulation")
     }
 }
 
@@ -218,6 +284,80 @@ struct SeedFigures {
     fix_n: usize,
     ends_15: Vec<OutageEnd>,
     ends_30: Vec<OutageEnd>,
+    /// Heading error of the initial state against the truth, deg.
+    init_yaw_err_deg: f64,
+}
+
+/// A forward run and its full-GNSS figure (Σ e² and count of the one-step prediction
+/// errors, `SessionResult::horizontal_rms_m`'s definition).
+struct Forward {
+    run: ForwardRun,
+    t_init: f64,
+    init_yaw_rad: f64,
+    pred_ss: f64,
+    pred_n: usize,
+}
+
+/// The session on the walk; with `true_attitude`, the session's own steps (σ floor,
+/// gyro priming, in-motion initial state) with the initial attitude and velocity
+/// replaced by the truth, run by `run_forward` (the one-step figure then counted here
+/// like the session counts it: accepted position fixes from `converge_s` after the
+/// start, outside each outage and `reconverge_s` after it).
+fn forward(imu: &ImuStream, sim: &Simulation, cfg: &SessionConfig, true_attitude: bool) -> Forward {
+    let g = sim.gnss.as_ref().expect("GNSS");
+    if !true_attitude {
+        let r = run_session(imu, g, cfg).expect("session");
+        let (rms, n) = r.horizontal_rms_m.unwrap_or((0.0, 0));
+        return Forward {
+            t_init: r.init.nav.time_s,
+            init_yaw_rad: Euler::from_dcm(&r.init.nav.q_bn.to_dcm()).yaw_rad,
+            pred_ss: rms * rms * n as f64,
+            pred_n: n,
+            run: r.run,
+        };
+    }
+    let mut floored = g.clone();
+    if let Some((h, v)) = cfg.sigma_floor_m {
+        for s in &mut floored.sigma_ned_m {
+            *s = [s[0].max(h), s[1].max(h), s[2].max(v)];
+        }
+    }
+    let primed = prime_gyro_bias(imu, cfg.static_prime_s);
+    let mut init = initialise_in_motion(imu, &floored, cfg, primed).expect("initial state");
+    let k = truth_index(&sim.truth, init.nav.time_s);
+    let [r, p, y] = sim.truth.roll_pitch_yaw_rad[k];
+    init.nav.q_bn = Euler {
+        roll_rad: r,
+        pitch_rad: p,
+        yaw_rad: y,
+    }
+    .to_quat();
+    init.nav.vel_ned_m_s = sim.truth.vel_ned_m_s[k];
+    let mut fcfg = cfg.filter.clone();
+    fcfg.outages_s = cfg.outages.iter().map(|w| (w.start_s, w.end_s)).collect();
+    let run = run_forward(&imu.epochs, &floored, init, &fcfg).expect("forward run");
+    let t0 = init.nav.time_s;
+    let excluded = |t: f64| {
+        t < t0 + cfg.converge_s
+            || cfg
+                .outages
+                .iter()
+                .any(|w| t >= w.start_s && t <= w.end_s + cfg.reconverge_s)
+    };
+    let (mut pred_ss, mut pred_n) = (0.0, 0usize);
+    for o in run.updates.iter().flat_map(|u| u.outcomes.iter()) {
+        if o.kind == UpdateKind::Position && o.accepted && !excluded(o.time_s) {
+            pred_ss += o.innovation[0].powi(2) + o.innovation[1].powi(2);
+            pred_n += 1;
+        }
+    }
+    Forward {
+        run,
+        t_init: t0,
+        init_yaw_rad: y,
+        pred_ss,
+        pred_n,
+    }
 }
 
 /// End-of-outage figures of a run with the given windows (s after t = 0).
@@ -225,6 +365,7 @@ fn outage_ends(
     imu: &ImuStream,
     sim: &Simulation,
     cfg: &SessionConfig,
+    true_attitude: bool,
     starts: &[f64],
     len_s: f64,
 ) -> Vec<OutageEnd> {
@@ -238,7 +379,7 @@ fn outage_ends(
             end_s: t0 + a + len_s,
         })
         .collect();
-    let r = run_session(imu, g, &cfg).expect("outage run");
+    let r = forward(imu, sim, &cfg, true_attitude);
     cfg.outages
         .iter()
         .map(|w| {
@@ -270,9 +411,12 @@ fn seed_figures(sim: &Simulation, variant: Variant) -> SeedFigures {
     let imu = imu_stream(sim);
     let g = sim.gnss.as_ref().expect("GNSS");
     let cfg = variant.config(sim.lever_arm_b_m);
-    let full = run_session(&imu, g, &cfg).expect("full-GNSS run");
-    let (pred_rms, pred_n) = full.horizontal_rms_m.expect("prediction errors");
-    let from = full.init.nav.time_s + cfg.converge_s;
+    let true_att = matches!(
+        variant,
+        Variant::FloorAtMotionTrueHeading | Variant::Chi2GateTrueHeading
+    );
+    let full = forward(&imu, sim, &cfg, true_att);
+    let from = full.t_init + cfg.converge_s;
     let (mut fix_ss, mut fix_n) = (0.0, 0usize);
     for (t, e) in g.time_s.iter().zip(fix_errors(sim)) {
         if *t >= from {
@@ -280,16 +424,19 @@ fn seed_figures(sim: &Simulation, variant: Variant) -> SeedFigures {
             fix_n += 1;
         }
     }
+    let k = truth_index(&sim.truth, full.t_init);
+    let dyaw = (full.init_yaw_rad - sim.truth.roll_pitch_yaw_rad[k][2]).to_degrees();
     SeedFigures {
+        init_yaw_err_deg: (dyaw + 180.0).rem_euclid(360.0) - 180.0,
         accepted: full.run.gnss_accepted,
         rejected: full.run.gnss_rejected,
         forced: full.run.gnss_forced,
-        pred_ss: pred_rms * pred_rms * pred_n as f64,
-        pred_n,
+        pred_ss: full.pred_ss,
+        pred_n: full.pred_n,
         fix_ss,
         fix_n,
-        ends_15: outage_ends(&imu, sim, &cfg, &OUTAGES_15, 15.0),
-        ends_30: outage_ends(&imu, sim, &cfg, &OUTAGES_30, 30.0),
+        ends_15: outage_ends(&imu, sim, &cfg, true_att, &OUTAGES_15, 15.0),
+        ends_30: outage_ends(&imu, sim, &cfg, true_att, &OUTAGES_30, 30.0),
     }
 }
 
@@ -304,6 +451,8 @@ struct Pooled {
     /// (share covered, mean error, mean bound, mean e²/σ²) for 15 s and 30 s.
     ends_15: (f64, f64, f64, f64),
     ends_30: (f64, f64, f64, f64),
+    /// RMS initial heading error, deg.
+    init_yaw_rms_deg: f64,
 }
 
 impl Pooled {
@@ -338,6 +487,7 @@ fn pool(figs: &[SeedFigures]) -> Pooled {
             .fold(0.0, f64::max),
         ends_15: ends(figs.iter().flat_map(|f| f.ends_15.clone()).collect()),
         ends_30: ends(figs.iter().flat_map(|f| f.ends_30.clone()).collect()),
+        init_yaw_rms_deg: (sum(|f| f.init_yaw_err_deg.powi(2)) / figs.len() as f64).sqrt(),
     }
 }
 
@@ -350,15 +500,21 @@ fn study(variants: &[Variant]) -> Vec<Pooled> {
         sims.len(),
         clock.elapsed().as_secs_f64()
     );
+    let needs_own =
+        |v: Variant| matches!(v, Variant::RigidAntenna | Variant::FloorAtMotionNoiseOnly);
     eprintln!(
         "| variant | (a) rejected | forced | (b) pred RMS / fix RMS = ratio (worst seed) | \
-         (c) 15 s: covered, mean e_h, mean 3σ_h, mean e²/σ² | 30 s: covered, mean e_h, mean 3σ_h, mean e²/σ² |"
+         (c) 15 s: covered, mean e_h, mean 3σ_h, mean e²/σ² | 30 s: covered, mean e_h, mean 3σ_h, mean e²/σ² | initial heading error RMS |"
     );
     variants
         .iter()
         .map(|&v| {
             let c = Instant::now();
-            let figs: Vec<SeedFigures> = sims.iter().map(|s| seed_figures(s, v)).collect();
+            let figs: Vec<SeedFigures> = if needs_own(v) {
+                SEEDS.map(|seed| seed_figures(&v.walk(seed), v)).collect()
+            } else {
+                sims.iter().map(|s| seed_figures(s, v)).collect()
+            };
             let p = pool(&figs);
             let row = |e: (f64, f64, f64, f64)| {
                 format!(
@@ -370,7 +526,7 @@ fn study(variants: &[Variant]) -> Vec<Pooled> {
                 )
             };
             eprintln!(
-                "| {} | {:.2} % | {} | {:.3} / {:.3} m = {:.2} ({:.2}) | {} | {} | ({:.1} s)",
+                "| {} | {:.2} % | {} | {:.3} / {:.3} m = {:.2} ({:.2}) | {} | {} | {:.1}° | ({:.1} s)",
                 v.label(),
                 100.0 * p.rejected_share,
                 p.forced,
@@ -380,6 +536,7 @@ fn study(variants: &[Variant]) -> Vec<Pooled> {
                 p.worst_seed_ratio,
                 row(p.ends_15),
                 row(p.ends_30),
+                p.init_yaw_rms_deg,
                 c.elapsed().as_secs_f64()
             );
             p
@@ -612,7 +769,10 @@ fn walk_study_meets_the_bars() {
 #[ignore = "measurement: prints the variant table"]
 fn measure_walk_filter_variants() {
     let clock = Instant::now();
-    let rows = study(&Variant::ALL);
+    let rows = study(&Variant::STUDY);
     assert_eq!(rows.len(), 3);
+    if std::env::var_os("WALK_DIAGNOSTICS").is_some() {
+        study(&Variant::DIAGNOSTICS);
+    }
     eprintln!("total {:.1} s", clock.elapsed().as_secs_f64());
 }
