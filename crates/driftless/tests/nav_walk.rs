@@ -63,7 +63,10 @@
 //! not move.) Reading: no variant of today's filter meets all three bars. Two things
 //! break it, each visible on its own: (1) the initial heading — from the central
 //! difference of fixes whose antenna moves by decimetres, at 0.8 m/s, it is wrong by
-//! 48° RMS (1.4° with a rigid antenna), and every variant started there misses (c);
+//! 48° RMS (1.4° with a rigid antenna): 3 of the 20 seeds start during the initial
+//! standstill, the antenna motion alone faking more than 0.8 m/s (heading errors 175°,
+//! 106°, 26°), the other 17 at a true 0.6–1.1 m/s with 14° RMS (worst 38.5°); every
+//! variant started there misses (c);
 //! (2) the 1-cm formal σ against 0.28-m antenna motion — the χ² gate then rejects 80 %
 //! of the fixes even from the true attitude (H), while a σ floor at the motion's σ with
 //! the true attitude (G) comes close to every bar (a 2.3 %, b 1.26×, c 91 / 92 %).
@@ -115,13 +118,7 @@ fn walk(seed: u64) -> Simulation {
 
 /// The simulated increments as the session's IMU stream (body = vehicle axes).
 fn imu_stream(sim: &Simulation) -> ImuStream {
-    ImuStream {
-        source: "walk-yard.toml".into(),
-        gps_week: None,
-        nominal_dt_s: sim.imu.dt_s,
-        epochs: sim.imu.to_increments(),
-        gaps: Vec::new(),
-    }
+    sim.imu_stream("walk-yard.toml")
 }
 
 /// Filter noise from the `consumer` preset's numbers (`sim::presets::consumer`): white

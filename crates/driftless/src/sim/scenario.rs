@@ -722,6 +722,20 @@ impl Simulation {
         out.to_imu_log(source)
     }
 
+    /// The IMU output as the navigation session's input
+    /// ([`crate::nav::session::run_session`]): increments on output time in the IMU's
+    /// own axes (with a profile `[mounting]`, the session needs that rotation too), GPS
+    /// week from the GNSS output when there is one.
+    pub fn imu_stream(&self, source: &str) -> crate::nav::pipeline::ImuStream {
+        crate::nav::pipeline::ImuStream {
+            source: source.to_owned(),
+            gps_week: self.gnss.as_ref().and_then(|g| g.gps_week),
+            nominal_dt_s: self.imu.dt_s,
+            epochs: self.imu.to_increments(),
+            gaps: Vec::new(),
+        }
+    }
+
     /// The IMU output as KF-GINS increments.
     pub fn increments(&self) -> crate::io::nav::ImuIncrements {
         crate::nav::pipeline::increment_columns(&self.imu.to_increments())
@@ -791,6 +805,10 @@ outages = "8+5"
             (dur * 100.0 + 1e-9).floor() as usize + 1
         );
         assert_eq!(a.initial.time_s, 100_000.0);
+        let stream = a.imu_stream("p.toml");
+        assert_eq!(stream.len(), a.imu.len());
+        assert_eq!(stream.nominal_dt_s, 0.01);
+        assert!((stream.epochs[0].time_s - 100_000.01).abs() < 1e-9);
         let mut s2 = s.clone();
         s2.seed = 4;
         assert_ne!(s2.run().unwrap().imu, a.imu);
