@@ -82,6 +82,7 @@ use std::time::Instant;
 use driftless::io::nav::{NavSolution, quality};
 use driftless::nav::attitude::Euler;
 use driftless::nav::earth::ned_offset_m;
+use driftless::nav::filter::state::POS;
 use driftless::nav::filter::{
     FilterConfig, ForwardRun, GaussMarkov, ImuNoise, UpdateKind, run_forward,
 };
@@ -398,7 +399,7 @@ fn outage_ends(
             );
             OutageEnd {
                 error_m: d[0].hypot(d[1]),
-                sigma_h_m: e.std[0].hypot(e.std[1]),
+                sigma_h_m: e.std[POS].hypot(e.std[POS + 1]),
             }
         })
         .collect()
