@@ -349,6 +349,7 @@ fn test_profile() -> (MotionProfile, Vec<Dynamics>) {
             speed_m_s: 0.0,
         },
         mounting: MountingSpec::default(),
+        gait: None,
         segments: list.iter().map(|x| x.0).collect(),
     };
     (profile, list.iter().map(|x| x.1).collect())
@@ -475,6 +476,7 @@ fn synthetic_drive(blocks: usize) -> NavSolution {
             speed_m_s: 0.0,
         },
         mounting: MountingSpec::default(),
+        gait: None,
         segments,
     };
     let lv = profile.build().unwrap();

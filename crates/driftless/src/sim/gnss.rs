@@ -13,8 +13,21 @@
 //! [`crate::nav::filter`] inverted; the Earth-rate term of the antenna velocity,
 //! |ω_ie × C_bn l| ≤ 7e-5 m/s per metre of lever arm, is left out as the filter leaves
 //! it out.) Errors are white Gaussian per NED axis with the configured σ, optionally
-//! plus a first-order Gauss–Markov error per axis (multipath-like, correlated over
-//! `correlated_tau_s`) — the reported σ then covers both. Reproducible from `seed`.
+//! plus a first-order Gauss–Markov error per axis (multipath-like, or the motion of a
+//! hand-held antenna relative to the IMU-carried point, correlated over
+//! `correlated_tau_s`): x_k = φx_{k−1} + σ√(1 − φ²)·w_k, φ = exp(−Δt/τ), started from its
+//! stationary distribution, so Var x_k = σ² and E x_k x_{k+m} = σ²φ^m.
+//!
+//! The σ written with each fix is by default the true total σ per axis,
+//! √(σ_white² + σ_corr²). Real receivers report a *formal* σ that ignores such errors
+//! (a u-blox RTK fixed solution reports ~1 cm whatever the antenna does):
+//! `reported_sigma_ned_m` writes that σ instead, while the error stays as configured.
+//!
+//! [`DegradedWindow`]s model stretches of worse solutions, e.g. RTK float: inside a
+//! window the fixes carry its quality flag (default float, 2), its reported σ, and an
+//! extra first-order Gauss–Markov error of its own σ and τ (stationary at the window's
+//! first epoch, independent between windows) on top of the errors above — the float
+//! ambiguities' slowly wandering decimetre-level offset. Reproducible from `seed`.
 
 use serde::{Deserialize, Serialize};
 
@@ -56,6 +69,13 @@ pub struct GnssSimConfig {
     /// Number of satellites reported.
     #[serde(default = "default_sats")]
     pub n_sats: u8,
+    /// σ written with every fix outside the degraded windows (the receiver's formal σ),
+    /// north, east, down, m; `None` writes the true total σ (module documentation).
+    #[serde(default)]
+    pub reported_sigma_ned_m: Option<Vec3>,
+    /// Windows of degraded solutions (RTK float …), ordered and not overlapping.
+    #[serde(default)]
+    pub degraded_windows: Vec<DegradedWindow>,
     /// Windows (start, end) without fixes, s.
     #[serde(default)]
     pub outages_s: Vec<(f64, f64)>,
@@ -65,6 +85,30 @@ pub struct GnssSimConfig {
     /// GPS week of the output time stamps.
     #[serde(default)]
     pub gps_week: Option<u16>,
+}
+
+/// A stretch of degraded fixes (module documentation), times on the trajectory's clock
+/// (inclusive).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DegradedWindow {
+    /// First time in the window, s.
+    pub start_s: f64,
+    /// Last time in the window, s.
+    pub end_s: f64,
+    /// RTKLIB quality flag of its fixes (default float, 2).
+    #[serde(default = "default_degraded_quality")]
+    pub quality: u8,
+    /// Extra first-order Gauss–Markov error σ per NED axis, m.
+    pub sigma_ned_m: Vec3,
+    /// Its correlation time, s.
+    pub tau_s: f64,
+    /// σ written with its fixes, north, east, down, m.
+    pub reported_sigma_ned_m: Vec3,
+}
+
+fn default_degraded_quality() -> u8 {
+    crate::io::nav::quality::FLOAT
 }
 
 fn default_tau() -> f64 {
@@ -92,6 +136,8 @@ impl GnssSimConfig {
             lever_arm_b_m: [0.0; 3],
             quality: default_quality(),
             n_sats: default_sats(),
+            reported_sigma_ned_m: None,
+            degraded_windows: Vec::new(),
             outages_s: Vec::new(),
             time_offset_s: 0.0,
             gps_week: None,
@@ -99,7 +145,8 @@ impl GnssSimConfig {
     }
 
     /// Checks every value (rates and times finite and positive where needed, σ ≥ 0 with a
-    /// positive total per axis, outage windows ordered).
+    /// positive total per axis, reported σ > 0, outage windows ordered, degraded windows
+    /// ordered and disjoint).
     pub fn validate(&self) -> Result<(), SimError> {
         let bad = |name: &'static str, value: f64, why: &'static str| {
             Err(SimError::Invalid { name, value, why })
@@ -156,6 +203,50 @@ impl GnssSimConfig {
                 return bad("gnss.outages_s", a, "each window needs finite start < end");
             }
         }
+        let positive3 =
+            |name: &'static str, v: &Vec3| match v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+                Some(&x) => bad(name, x, "must be finite and > 0 on every axis"),
+                None => Ok(()),
+            };
+        if let Some(r) = &self.reported_sigma_ned_m {
+            positive3("gnss.reported_sigma_ned_m", r)?;
+        }
+        let mut last_end = f64::NEG_INFINITY;
+        for w in &self.degraded_windows {
+            if !(w.start_s.is_finite() && w.end_s.is_finite() && w.end_s > w.start_s) {
+                return bad(
+                    "gnss.degraded_windows.start_s",
+                    w.start_s,
+                    "each window needs finite start_s < end_s",
+                );
+            }
+            if w.start_s <= last_end {
+                return bad(
+                    "gnss.degraded_windows.start_s",
+                    w.start_s,
+                    "windows must be in time order and must not overlap",
+                );
+            }
+            last_end = w.end_s;
+            if let Some(&x) = w
+                .sigma_ned_m
+                .iter()
+                .find(|x| !(x.is_finite() && **x >= 0.0))
+            {
+                return bad(
+                    "gnss.degraded_windows.sigma_ned_m",
+                    x,
+                    "must be finite and ≥ 0",
+                );
+            }
+            if !(w.tau_s.is_finite() && w.tau_s > 0.0) {
+                return bad("gnss.degraded_windows.tau_s", w.tau_s, "must be > 0");
+            }
+            positive3(
+                "gnss.degraded_windows.reported_sigma_ned_m",
+                &w.reported_sigma_ned_m,
+            )?;
+        }
         Ok(())
     }
 }
@@ -178,8 +269,12 @@ pub fn simulate_gnss<T: Trajectory + ?Sized>(
     for (c, s) in corr.iter_mut().zip(cfg.correlated_sigma_ned_m) {
         *c = s * corr_rng.normal(); // stationary start
     }
-    let sigma_total: Vec3 =
-        std::array::from_fn(|k| cfg.sigma_ned_m[k].hypot(cfg.correlated_sigma_ned_m[k]));
+    let sigma_total: Vec3 = cfg.reported_sigma_ned_m.unwrap_or_else(|| {
+        std::array::from_fn(|k| cfg.sigma_ned_m[k].hypot(cfg.correlated_sigma_ned_m[k]))
+    });
+    // Degraded windows: index of the window of the previous epoch and its error.
+    let mut deg_rng = Rng::stream(seed, 0x6e55_0004);
+    let mut deg: Option<(usize, Vec3)> = None;
     let mut g = GnssFixes {
         gps_week: cfg.gps_week,
         n_sats: Some(Vec::with_capacity(n)),
@@ -194,7 +289,28 @@ pub fn simulate_gnss<T: Trajectory + ?Sized>(
                 *c = phi * *c + s * drive * corr_rng.normal();
             }
         }
-        let e: Vec3 = std::array::from_fn(|a| cfg.sigma_ned_m[a] * white.normal() + corr[a]);
+        let mut e: Vec3 = std::array::from_fn(|a| cfg.sigma_ned_m[a] * white.normal() + corr[a]);
+        let window = cfg
+            .degraded_windows
+            .iter()
+            .position(|w| t >= w.start_s && t <= w.end_s);
+        deg = window.map(|i| {
+            let w = &cfg.degraded_windows[i];
+            let x: Vec3 = match deg {
+                Some((j, x)) if j == i => {
+                    let phi = (-dt / w.tau_s).exp();
+                    let drive = (1.0 - phi * phi).sqrt();
+                    std::array::from_fn(|a| {
+                        phi * x[a] + w.sigma_ned_m[a] * drive * deg_rng.normal()
+                    })
+                }
+                _ => std::array::from_fn(|a| w.sigma_ned_m[a] * deg_rng.normal()),
+            };
+            (i, x)
+        });
+        if let Some((_, x)) = deg {
+            e = add(e, x);
+        }
         let ve: Vec3 = match cfg.velocity_sigma_ned_m_s {
             Some(s) => std::array::from_fn(|a| s[a] * vel_rng.normal()),
             None => [0.0; 3],
@@ -210,8 +326,17 @@ pub fn simulate_gnss<T: Trajectory + ?Sized>(
         g.lat_rad.push(p.lat_rad + d[0] / rm);
         g.lon_rad.push(p.lon_rad + d[1] / (rn * p.lat_rad.cos()));
         g.height_m.push(p.height_m - d[2]);
-        g.sigma_ned_m.push(sigma_total);
-        g.quality.push(cfg.quality);
+        match window {
+            Some(i) => {
+                let w = &cfg.degraded_windows[i];
+                g.sigma_ned_m.push(w.reported_sigma_ned_m);
+                g.quality.push(w.quality);
+            }
+            None => {
+                g.sigma_ned_m.push(sigma_total);
+                g.quality.push(cfg.quality);
+            }
+        }
         if let Some(ns) = g.n_sats.as_mut() {
             ns.push(cfg.n_sats);
         }
@@ -329,11 +454,106 @@ mod tests {
         }
     }
 
+    /// A receiver's formal σ (1 cm) is written while the true error is the configured
+    /// 0.25-m antenna motion (lag-τ autocorrelation e⁻¹); inside a degraded window the
+    /// fixes carry the float flag, its σ, and the extra error.
+    #[test]
+    fn reported_sigma_and_degraded_windows() {
+        let traj = turn();
+        let mut cfg = GnssSimConfig::new(4.0, 0.0, 4000.0, 0.005);
+        cfg.correlated_sigma_ned_m = [0.25, 0.25, 0.1];
+        cfg.correlated_tau_s = 3.0;
+        cfg.reported_sigma_ned_m = Some([0.01, 0.01, 0.02]);
+        cfg.degraded_windows = vec![DegradedWindow {
+            start_s: 2000.0,
+            end_s: 3000.0,
+            quality: crate::io::nav::quality::FLOAT,
+            sigma_ned_m: [0.4, 0.4, 0.8],
+            tau_s: 5.0,
+            reported_sigma_ned_m: [0.2, 0.2, 0.4],
+        }];
+        let g = simulate_gnss(&traj, &cfg, 11).unwrap();
+        let err = |i: usize| {
+            let p = traj.point(g.time_s[i]);
+            earth::ned_offset_m(
+                (p.lat_rad, p.lon_rad, p.height_m),
+                (g.lat_rad[i], g.lon_rad[i], g.height_m[i]),
+            )
+        };
+        let inside = |t: f64| (2000.0..=3000.0).contains(&t);
+        let (mut ss_out, mut ss_in, mut n_out, mut n_in) = ([0.0; 3], [0.0; 3], 0.0, 0.0);
+        let lag = 12; // τ = 3 s at 4 Hz
+        let (mut c0, mut c1) = (0.0, 0.0);
+        for i in 0..g.len() {
+            let e = err(i);
+            let t = g.time_s[i];
+            if inside(t) {
+                assert_eq!(g.quality[i], crate::io::nav::quality::FLOAT);
+                assert_eq!(g.sigma_ned_m[i], [0.2, 0.2, 0.4]);
+                (0..3).for_each(|k| ss_in[k] += e[k] * e[k]);
+                n_in += 1.0;
+            } else {
+                assert_eq!(g.quality[i], crate::io::nav::quality::FIX);
+                assert_eq!(g.sigma_ned_m[i], [0.01, 0.01, 0.02]);
+                (0..3).for_each(|k| ss_out[k] += e[k] * e[k]);
+                n_out += 1.0;
+                if i + lag < g.len() && !inside(g.time_s[i + lag]) {
+                    c0 += e[0] * e[0];
+                    c1 += e[0] * err(i + lag)[0];
+                }
+            }
+        }
+        assert_eq!(n_in, 4001.0);
+        let want_out = [0.25, 0.25, 0.1].map(|c: f64| c.hypot(0.005));
+        let want_in: Vec<f64> = [0.4, 0.4, 0.8]
+            .iter()
+            .zip(want_out)
+            .map(|(d, o): (&f64, f64)| d.hypot(o))
+            .collect();
+        for k in 0..3 {
+            // ≈ 1000 (outside) and 200 (inside) correlation times: a few % and ≈ 7 %.
+            let (o, i) = ((ss_out[k] / n_out).sqrt(), (ss_in[k] / n_in).sqrt());
+            assert!((o / want_out[k] - 1.0).abs() < 0.1, "axis {k}: {o}");
+            assert!((i / want_in[k] - 1.0).abs() < 0.2, "axis {k}: {i}");
+        }
+        let rho = c1 / c0;
+        assert!(
+            (rho - (-1.0f64).exp()).abs() < 0.1,
+            "lag-τ autocorrelation {rho}"
+        );
+    }
+
     #[test]
     fn bad_settings_are_named() {
         let traj = turn();
         type Edit = fn(&mut GnssSimConfig);
-        let cases: [(&str, Edit); 6] = [
+        fn deg(c: &mut GnssSimConfig, a: f64, b: f64) {
+            c.degraded_windows.push(DegradedWindow {
+                start_s: a,
+                end_s: b,
+                quality: 2,
+                sigma_ned_m: [0.3; 3],
+                tau_s: 10.0,
+                reported_sigma_ned_m: [0.1; 3],
+            })
+        }
+        let cases: [(&str, Edit); 11] = [
+            ("gnss.reported_sigma_ned_m", |c| {
+                c.reported_sigma_ned_m = Some([0.01, 0.0, 0.01])
+            }),
+            ("gnss.degraded_windows.start_s", |c| {
+                deg(c, 2.0, 5.0);
+                deg(c, 4.0, 6.0)
+            }),
+            ("gnss.degraded_windows.start_s", |c| deg(c, 5.0, 5.0)),
+            ("gnss.degraded_windows.tau_s", |c| {
+                deg(c, 2.0, 5.0);
+                c.degraded_windows[0].tau_s = 0.0
+            }),
+            ("gnss.degraded_windows.reported_sigma_ned_m", |c| {
+                deg(c, 2.0, 5.0);
+                c.degraded_windows[0].reported_sigma_ned_m[2] = f64::NAN
+            }),
             ("gnss.rate_hz", |c| c.rate_hz = 0.0),
             ("gnss.end_s", |c| c.end_s = -1.0),
             ("gnss.sigma_ned_m", |c| c.sigma_ned_m = [0.0; 3]),

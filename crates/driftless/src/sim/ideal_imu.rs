@@ -494,6 +494,8 @@ struct SegStart {
     t0: f64,
     /// Local (n, e, d) at the start.
     p0: Vec3,
+    /// Horizontal distance travelled before the segment, m.
+    s0: f64,
     yaw0: f64,
     /// Horizontal speed at the start, m/s.
     v0: f64,
@@ -513,6 +515,56 @@ struct Kinematics {
     pitch_rate: f64,
     /// Horizontal speed, m/s.
     speed: f64,
+    /// Horizontal distance travelled since the start of the drive, m.
+    dist: f64,
+    /// Rate of change of the horizontal speed, m/s².
+    along_acc: f64,
+}
+
+/// Hand-held carriage of the IMU by a walker, superposed on a [`LandVehicle`] path
+/// (its speeds then being walking speeds). The motion is a function of the horizontal
+/// distance walked s (so it stops when the walker stops and its frequency follows the
+/// speed: V/L steps per second), with k = 2π/L:
+///
+/// * vertical bob, one period per step: Δd = −A_b sin(ks) (positive up);
+/// * pitch sway, one period per step: Δθ = A_p sin(ks), added to the path pitch;
+/// * roll sway, one period per stride of two steps: φ = A_r sin(ks/2).
+///
+/// Derivatives by the chain rule with ṡ = V and s̈ = V̇:
+/// Δḋ = −A_b k cos(ks)·ṡ, Δd̈ = A_b k² sin(ks)·ṡ² − A_b k cos(ks)·s̈,
+/// Δθ̇ = A_p k cos(ks)·ṡ, φ̇ = ½A_r k cos(ks/2)·ṡ. Typical hand-held values: step length
+/// 0.6–0.75 m (≈ 2 steps/s at 1.2–1.5 m/s), bob 1–3 cm (vertical acceleration amplitude
+/// A_b(kV)² ≈ 1.6–4.7 m/s² at 2 Hz), sway 1–3°.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gait {
+    /// Step length L, m (> 0).
+    pub step_length_m: f64,
+    /// Vertical bob amplitude A_b, m.
+    pub bob_amplitude_m: f64,
+    /// Pitch sway amplitude A_p, rad.
+    pub pitch_amplitude_rad: f64,
+    /// Roll sway amplitude A_r, rad.
+    pub roll_amplitude_rad: f64,
+}
+
+impl Gait {
+    /// (Δd, Δḋ, Δd̈, φ, φ̇, Δθ, Δθ̇) at distance `s`, speed `sd`, along-track acceleration
+    /// `sdd` (type documentation).
+    fn offsets(&self, s: f64, sd: f64, sdd: f64) -> [f64; 7] {
+        let k = 2.0 * std::f64::consts::PI / self.step_length_m;
+        let (sn, cs) = (k * s).sin_cos();
+        let (sh, ch) = (0.5 * k * s).sin_cos();
+        let ab = self.bob_amplitude_m;
+        [
+            -ab * sn,
+            -ab * k * cs * sd,
+            ab * k * k * sn * sd * sd - ab * k * cs * sdd,
+            self.roll_amplitude_rad * sh,
+            0.5 * self.roll_amplitude_rad * k * ch * sd,
+            self.pitch_amplitude_rad * sn,
+            self.pitch_amplitude_rad * k * cs * sd,
+        ]
+    }
 }
 
 /// (d) A land-vehicle drive composed of [`DriveSegment`]s: stops, straight runs with
@@ -530,12 +582,16 @@ struct Kinematics {
 /// analytically; after the last one the vehicle keeps its final speed and heading.
 /// Acceleration and body rate may jump at segment joins (a turn's yaw rate starts at
 /// once): the joins are reported by [`Trajectory::next_break_s`] so that the ideal
-/// increments integrate each piece separately.
+/// increments integrate each piece separately. [`LandVehicle::with_gait`] turns the
+/// drive into a hand-held walk: a [`Gait`] adds a vertical bob and pitch/roll sway to
+/// the vehicle frame (then the velocity is no longer along its x axis, and the body
+/// rate uses the general z-y-x Euler-rate relation with the roll).
 #[derive(Clone, Debug)]
 pub struct LandVehicle {
     origin: LocalOrigin,
     c_vb: Mat3,
     segs: Vec<SegStart>,
+    gait: Option<Gait>,
 }
 
 impl LandVehicle {
@@ -553,10 +609,12 @@ impl LandVehicle {
     ) -> LandVehicle {
         let mut segs = Vec::with_capacity(segments.len());
         let (mut t, mut p, mut yaw, mut v) = (0.0, [0.0; 3], yaw0_rad, speed0_m_s);
+        let mut dist = 0.0;
         for &seg in segments {
             let st = SegStart {
                 t0: t,
                 p0: p,
+                s0: dist,
                 yaw0: yaw,
                 v0: v,
                 seg,
@@ -571,11 +629,13 @@ impl LandVehicle {
             p = end.p;
             yaw = end.yaw;
             v = end.speed;
+            dist = end.dist;
         }
         if segs.is_empty() {
             segs.push(SegStart {
                 t0: 0.0,
                 p0: [0.0; 3],
+                s0: 0.0,
                 yaw0: yaw0_rad,
                 v0: speed0_m_s,
                 seg: DriveSegment::Stop { duration_s: 1.0 },
@@ -585,6 +645,7 @@ impl LandVehicle {
         segs.push(SegStart {
             t0: t,
             p0: p,
+            s0: dist,
             yaw0: yaw,
             v0: v,
             seg: DriveSegment::Speed {
@@ -596,7 +657,14 @@ impl LandVehicle {
             origin: LocalOrigin::new(lat_rad, lon_rad, height_m),
             c_vb,
             segs,
+            gait: None,
         }
+    }
+
+    /// The same drive carried by a walker ([`Gait`]); `None` removes the gait.
+    pub fn with_gait(mut self, gait: Option<Gait>) -> LandVehicle {
+        self.gait = gait;
+        self
     }
 
     /// Total duration of the given segments, s.
@@ -623,6 +691,8 @@ impl SegStart {
             pitch: 0.0,
             pitch_rate: 0.0,
             speed: 0.0,
+            dist: self.s0,
+            along_acc: 0.0,
         };
         match self.seg {
             DriveSegment::Stop { .. } => level(self.p0[0], self.p0[1], 0.0, 0.0, 0.0, 0.0),
@@ -641,6 +711,8 @@ impl SegStart {
                 };
                 Kinematics {
                     speed: v,
+                    dist: self.s0 + s,
+                    along_acc: a,
                     ..level(
                         self.p0[0] + s * cy,
                         self.p0[1] + s * sy,
@@ -669,6 +741,7 @@ impl SegStart {
                     yaw: psi,
                     yaw_rate: w,
                     speed: v,
+                    dist: self.s0 + v * tau,
                     ..level(pn, pe, v * cp, v * sp, -v * w * sp, v * w * cp)
                 }
             }
@@ -693,6 +766,8 @@ impl SegStart {
                     pitch: h_d.atan2(v),
                     pitch_rate: v * h_dd / (v * v + h_d * h_d),
                     speed: v,
+                    dist: self.s0 + s,
+                    along_acc: 0.0,
                 }
             }
         }
@@ -703,16 +778,33 @@ impl Trajectory for LandVehicle {
     fn point(&self, t_s: f64) -> TrajectoryPoint {
         let i = self.segs.partition_point(|s| s.t0 <= t_s).saturating_sub(1);
         let sg = &self.segs[i];
-        let k = sg.eval(t_s - sg.t0);
+        let mut k = sg.eval(t_s - sg.t0);
+        let mut roll = (0.0, 0.0);
+        if let Some(g) = &self.gait {
+            let [d, dd, ddd, r, rd, th, thd] = g.offsets(k.dist, k.speed, k.along_acc);
+            k.p[2] += d;
+            k.v[2] += dd;
+            k.a[2] += ddd;
+            k.pitch += th;
+            k.pitch_rate += thd;
+            roll = (r, rd);
+        }
         let c_vn = Euler {
-            roll_rad: 0.0,
+            roll_rad: roll.0,
             pitch_rad: k.pitch,
             yaw_rad: k.yaw,
         }
         .to_dcm();
         let c_bn = c_vn.mul_mat(&self.c_vb);
+        // z-y-x Euler rates → body rate (Titterton & Weston 2004, §3.6):
+        // ω = (φ̇ − ψ̇ sin θ, θ̇ cos φ + ψ̇ sin φ cos θ, −θ̇ sin φ + ψ̇ cos φ cos θ).
         let (sp, cp) = k.pitch.sin_cos();
-        let omega_nv_v = [-k.yaw_rate * sp, k.pitch_rate, k.yaw_rate * cp];
+        let (sr, cr) = roll.0.sin_cos();
+        let omega_nv_v = [
+            roll.1 - k.yaw_rate * sp,
+            k.pitch_rate * cr + k.yaw_rate * sr * cp,
+            -k.pitch_rate * sr + k.yaw_rate * cr * cp,
+        ];
         let omega_nb_b = self.c_vb.t().mul_vec(omega_nv_v);
         self.origin.point(k.p, k.v, k.a, c_bn, omega_nb_b)
     }
@@ -897,6 +989,103 @@ mod tests {
         }
         assert!((lv.point(30.0).height_m - 22.0).abs() < 1e-9);
         assert!(Euler::from_dcm(&lv.point(5.0).c_bn.mul_mat(&c_vb.t())).pitch_rad > 5.0 * DEG);
+    }
+
+    /// A walk with a gait (start from rest, a 3-m-radius turn, a stop): analytic v̇^n and
+    /// ω_nb^b agree with finite differences of the position and attitude, the bob and
+    /// sway have their closed-form values and stop with the walker.
+    #[test]
+    fn walk_with_gait_derivatives() {
+        let gait = Gait {
+            step_length_m: 0.6,
+            bob_amplitude_m: 0.02,
+            pitch_amplitude_rad: 1.5 * DEG,
+            roll_amplitude_rad: 2.0 * DEG,
+        };
+        let v = 1.2;
+        let lv = LandVehicle::new(
+            45.0 * DEG,
+            7.0 * DEG,
+            300.0,
+            30.0 * DEG,
+            0.0,
+            Mat3::IDENTITY,
+            &[
+                DriveSegment::Stop { duration_s: 2.0 },
+                DriveSegment::Speed {
+                    to_m_s: v,
+                    duration_s: 1.5,
+                },
+                DriveSegment::Turn {
+                    angle_rad: -1.5,
+                    duration_s: 1.5 * 3.0 / v,
+                },
+                DriveSegment::Speed {
+                    to_m_s: 0.0,
+                    duration_s: 1.0,
+                },
+                DriveSegment::Stop { duration_s: 2.0 },
+            ],
+        )
+        .with_gait(Some(gait));
+        let fd = FiniteDifference {
+            state: |t: f64| {
+                let p = lv.point(t);
+                (p.lat_rad, p.lon_rad, p.height_m, p.vel_ned_m_s, p.c_bn)
+            },
+            step_s: 1e-4,
+        };
+        for t in [2.3, 2.9, 3.4, 3.8, 4.6, 5.5, 6.9, 7.3] {
+            let (a, b) = (lv.point(t), fd.point(t));
+            for k in 0..3 {
+                assert!(
+                    (a.acc_ned_m_s2[k] - b.acc_ned_m_s2[k]).abs() < 1e-6,
+                    "t {t} acc {k}: {:?} {:?}",
+                    a.acc_ned_m_s2,
+                    b.acc_ned_m_s2
+                );
+                assert!(
+                    (a.omega_nb_b_rad_s[k] - b.omega_nb_b_rad_s[k]).abs() < 1e-7,
+                    "t {t} ω {k}: {:?} {:?}",
+                    a.omega_nb_b_rad_s,
+                    b.omega_nb_b_rad_s
+                );
+            }
+        }
+        // Mid-turn: 1.2 m/s at 3 m radius, 2 steps/s: bob −A_b sin(ks), roll A_r sin(ks/2)
+        // with s the distance walked (the speed-up covers v·T/2 = 0.9 m).
+        let t = 4.0;
+        let s = 0.9 + v * (t - 3.5);
+        let k = 2.0 * std::f64::consts::PI / 0.6;
+        let p = lv.point(t);
+        let plain = LandVehicle::new(
+            45.0 * DEG,
+            7.0 * DEG,
+            300.0,
+            30.0 * DEG,
+            0.0,
+            Mat3::IDENTITY,
+            &lv.segs.iter().map(|g| g.seg).take(5).collect::<Vec<_>>(),
+        );
+        let q = plain.point(t);
+        assert!((p.height_m - q.height_m - 0.02 * (k * s).sin()).abs() < 1e-9);
+        let e = Euler::from_dcm(&p.c_bn);
+        assert!((e.roll_rad - 2.0 * DEG * (0.5 * k * s).sin()).abs() < 1e-12);
+        assert!((e.pitch_rad - 1.5 * DEG * (k * s).sin()).abs() < 1e-12);
+        // The peak vertical acceleration A_b(kV)² ≈ 3.2 m/s² shows while walking.
+        let peak = (0..200)
+            .map(|i| lv.point(3.5 + i as f64 * 0.005).acc_ned_m_s2[2].abs())
+            .fold(0.0, f64::max);
+        assert!((peak - 0.02 * (k * v).powi(2)).abs() < 0.05, "{peak}");
+        // Standing still at the end: no motion at all.
+        let z = lv.point(lv.duration_s() - 0.5);
+        assert!(
+            z.vel_ned_m_s
+                .iter()
+                .chain(&z.omega_nb_b_rad_s)
+                .all(|x| *x == 0.0)
+        );
+        assert!(z.acc_ned_m_s2.iter().all(|x| *x == 0.0));
     }
 
     /// A join inside an IMU interval (a yaw rate switching on) is integrated piecewise:

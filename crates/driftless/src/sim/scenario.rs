@@ -31,12 +31,21 @@
 //! sigma_ned_m = [0.02, 0.02, 0.02]
 //! lever_arm_b_m = [0.0, 0.0, -1.0]
 //! outages = "9x60s every 300s from 300s"   # fixes removed from the output
+//! # correlated_sigma_ned_m = [0.2, 0.2, 0.1]  # Gauss–Markov error (antenna motion)
+//! # correlated_tau_s = 3.0
+//! # reported_sigma_ned_m = [0.01, 0.01, 0.02] # the receiver's formal σ in the files
+//! # [[gnss.degraded_windows]]                 # e.g. RTK float, s from the first fix
+//! # start_s = 60.0
+//! # end_s = 80.0
+//! # sigma_ned_m = [0.4, 0.4, 0.8]             # extra Gauss–Markov error
+//! # tau_s = 20.0
+//! # reported_sigma_ned_m = [0.15, 0.15, 0.3]
 //! ```
 //!
 //! Trajectory kinds: `recorded` ([`super::recorded`]: `file`, optional
 //! `position_cutoff_hz`, `roll = "zero" | "coordinated_turn"`), `profile`
-//! ([`super::profile`]: `file`, or the profile's `[start]`/`[mounting]`/`[[segment]]`
-//! inline under `[trajectory]`), `static` (`lat_deg`, `lon_deg`, `height_m`, `roll_deg`,
+//! ([`super::profile`]: `file`, or the profile's `[start]`/`[mounting]`/`[gait]`/
+//! `[[segment]]` inline under `[trajectory]`), `static` (`lat_deg`, `lon_deg`, `height_m`, `roll_deg`,
 //! `pitch_deg`, `yaw_deg`, `duration_s`) and `chamber` ([`super::chamber::ChamberConfig`]
 //! keys; its sample rate is `imu.rate_hz`). Relative paths resolve against the
 //! scenario file's folder. Unknown keys anywhere are errors naming the key.
@@ -166,6 +175,9 @@ pub enum TrajectorySpec {
         /// Inline `[mounting]`.
         #[serde(default)]
         mounting: Option<toml::Value>,
+        /// Inline `[gait]` (a hand-held walk).
+        #[serde(default)]
+        gait: Option<toml::Value>,
         /// Inline `[[segment]]`s.
         #[serde(default)]
         segment: Option<Vec<toml::Value>>,
@@ -220,6 +232,13 @@ pub struct GnssSpec {
     /// RTKLIB quality flag.
     #[serde(default)]
     pub quality: Option<u8>,
+    /// σ written with the fixes (the receiver's formal σ), m; default the true total σ.
+    #[serde(default)]
+    pub reported_sigma_ned_m: Option<[f64; 3]>,
+    /// Degraded (e.g. RTK float) windows, times relative to the first fix
+    /// ([`super::gnss::DegradedWindow`]).
+    #[serde(default)]
+    pub degraded_windows: Vec<super::gnss::DegradedWindow>,
     /// Outage windows (fixes removed), `--outages` grammar.
     #[serde(default)]
     pub outages: Option<String>,
@@ -453,6 +472,7 @@ impl Scenario {
                 file,
                 start,
                 mounting,
+                gait,
                 segment,
             } => {
                 let profile = match (file, start) {
@@ -463,6 +483,9 @@ impl Scenario {
                         t.insert("start".into(), start.clone());
                         if let Some(m) = mounting {
                             t.insert("mounting".into(), m.clone());
+                        }
+                        if let Some(g) = gait {
+                            t.insert("gait".into(), g.clone());
                         }
                         t.insert(
                             "segment".into(),
@@ -589,6 +612,16 @@ impl Scenario {
             if let Some(q) = g.quality {
                 cfg.quality = q;
             }
+            cfg.reported_sigma_ned_m = g.reported_sigma_ned_m;
+            cfg.degraded_windows = g
+                .degraded_windows
+                .iter()
+                .map(|w| super::gnss::DegradedWindow {
+                    start_s: w.start_s + t0,
+                    end_s: w.end_s + t0,
+                    ..w.clone()
+                })
+                .collect();
             cfg.time_offset_s = offset;
             cfg.gps_week = self.gps_week;
             // The first fix is at t0 (the start of the trajectory); 1 s margin at the end.
@@ -689,6 +722,20 @@ impl Simulation {
         out.to_imu_log(source)
     }
 
+    /// The IMU output as the navigation session's input
+    /// ([`crate::nav::session::run_session`]): increments on output time in the IMU's
+    /// own axes (with a profile `[mounting]`, the session needs that rotation too), GPS
+    /// week from the GNSS output when there is one.
+    pub fn imu_stream(&self, source: &str) -> crate::nav::pipeline::ImuStream {
+        crate::nav::pipeline::ImuStream {
+            source: source.to_owned(),
+            gps_week: self.gnss.as_ref().and_then(|g| g.gps_week),
+            nominal_dt_s: self.imu.dt_s,
+            epochs: self.imu.to_increments(),
+            gaps: Vec::new(),
+        }
+    }
+
     /// The IMU output as KF-GINS increments.
     pub fn increments(&self) -> crate::io::nav::ImuIncrements {
         crate::nav::pipeline::increment_columns(&self.imu.to_increments())
@@ -758,6 +805,10 @@ outages = "8+5"
             (dur * 100.0 + 1e-9).floor() as usize + 1
         );
         assert_eq!(a.initial.time_s, 100_000.0);
+        let stream = a.imu_stream("p.toml");
+        assert_eq!(stream.len(), a.imu.len());
+        assert_eq!(stream.nominal_dt_s, 0.01);
+        assert!((stream.epochs[0].time_s - 100_000.01).abs() < 1e-9);
         let mut s2 = s.clone();
         s2.seed = 4;
         assert_ne!(s2.run().unwrap().imu, a.imu);

@@ -1,0 +1,776 @@
+//! The navigation session on a simulated hand-held walk with known truth.
+//!
+//! **Setup.** `examples/scenarios/walk-yard.toml` (every magnitude sourced there): a
+//! consumer IMU (`consumer` preset, every error term, 100 Hz) carried by hand at
+//! 1.2 m/s through a 20 × 20 m yard — 10 s at rest, 2–4-m turns, stops of 4 and 5 s on
+//! the way and 5 s at the end,
+//! 2 steps/s with a ±2-cm bob and ±1.5°/±2° sway; 154 s in all — and u-blox-class RTK
+//! at 4 Hz whose antenna moves relative to the IMU-carried point (first-order
+//! Gauss–Markov, σ 0.2 / 0.2 / 0.1 m, τ 3 s) while the file says 1 cm (2 cm vertical),
+//! with 14 s of RTK float (132–146 s: extra error σ 0.4 / 0.4 / 0.8 m, τ 20 s, file σ
+//! 0.15 / 0.15 / 0.3 m). The scenario's seed is replaced by 1, 2, …, 20 (it drives the IMU
+//! and, through an independent stream, the GNSS noise).
+//!
+//! **Filter.** `nav::session::run_session` with only the geometry given — lever arm
+//! (0, 0, −0.25) m, mounting identity — and the default filter ([`FilterConfig::new`]:
+//! χ² gate 21.1, gate recovery 3 s, no aids), IMU noise from the `consumer` preset's
+//! numbers ([`walk_noise`]); no per-seed tuning. One deviation from the session defaults:
+//! `min_speed_m_s = 0.8` (the default 3 m/s is never reached on foot; the heading is
+//! then taken from the central difference of the fixes around the first epoch above
+//! 0.8 m/s). Three filter variants are measured: **A** the default χ² gate, **B** the
+//! fixes' σ floored at 0.1 m / 0.2 m (`SessionConfig::sigma_floor_m`), **C** no gate
+//! (`FilterConfig::chi2_gate = None`).
+//!
+//! **Figures** (per variant, pooled over the 20 seeds):
+//! (a) share of GNSS fixes rejected by the gate in the full-GNSS run,
+//!     rejected / (accepted + rejected);
+//! (b) full-GNSS fit: `SessionResult::horizontal_rms_m` (one-step prediction error at
+//!     accepted fixes from 60 s after the initialisation on) against the RMS horizontal
+//!     error of the fixes themselves (fix − true antenna: the antenna motion, plus the
+//!     white and float errors) over the fixes of the same span — ratio; bar ≤ 1.2;
+//! (c) 15-s outages starting 25, 55, 85, 110 s and 30-s outages starting 25, 65, 100 s
+//!     after t = 0 (two runs per seed; all end before the float stretch; they cover
+//!     turns, two of the stops and the walk resuming): at the last IMU epoch strictly
+//!     before the window's end (never a post-update state, whatever the window
+//!     convention), the horizontal error e_h of the IMU position against the truth and
+//!     the filter's σ_N, σ_E there (√diag P); the window counts as covered when
+//!     **|e_h| ≤ 3·√(σ_N² + σ_E²)**. Why this statistic: it needs only the diagonal of P
+//!     (the epoch record has no N–E covariance), it is invariant to rotating the
+//!     horizontal axes (σ_N² + σ_E² is the trace of the 2 × 2 block), and for a
+//!     consistent filter (e Gaussian with that block) its coverage is between 99.73 %
+//!     (all variance along one axis: |x| ≤ 3σ) and 99.99 % (circular: r² ≤ 18σ²,
+//!     1 − e⁻⁹) whatever the N–E correlation — so missing it in more than 10 % of
+//!     windows means the filter's σ under-states its error by a factor of ~2 or more,
+//!     not bad luck. Bar: ≥ 90 % of windows for each length. Reported alongside:
+//!     mean e_h, mean bound, and the mean of e_h²/(σ_N² + σ_E²) (≈ 1 when consistent).
+//!
+//! **Measured with today's filter** (release, 2 cores: 1.3 s to simulate the 20 walks,
+//! 2–3 s per variant for 20 seeds × 3 runs; `cargo test --release -p driftless --test
+//! nav_walk measure_ -- --ignored --nocapture`, with `WALK_DIAGNOSTICS=1` for D–H):
+//!
+//! | variant | (a) rejected | (b) one-step / fix RMS (worst seed) | (c) 15 s: covered, mean e_h, mean 3σ_h | (c) 30 s: covered, mean e_h, mean 3σ_h | initial heading error RMS |
+//! |---|---|---|---|---|---|
+//! | A default χ² gate | 81.5 % (696 forced) | 2.04 / 0.361 m = 5.67 (35.6) | 20.0 %, 52.6 m, 15.8 m | 25.0 %, 196 m, 58.4 m | 47.8° |
+//! | B σ floor 0.1 / 0.2 m | 12.2 % | 0.895 / 0.361 m = 2.48 (19.9) | 72.5 %, 25.3 m, 12.9 m | 70.0 %, 77.4 m, 43.3 m | 47.8° |
+//! | C no gate | 0 % | 0.876 / 0.361 m = 2.43 (8.8) | 11.2 %, 25.0 m, 5.9 m | 15.0 %, 81.8 m, 21.1 m | 47.8° |
+//! | D σ floor 0.3 / 0.3 m | 8.8 % | 1.114 / 0.361 m = 3.09 (19.2) | 82.5 %, 27.3 m, 20.4 m | 81.7 %, 80.5 m, 68.6 m | 47.8° |
+//! | E = A, antenna rigid on its lever arm | 4.7 % | 0.254 / 0.234 m = 1.09 (6.1) | 92.5 %, 3.7 m, 6.3 m | 91.7 %, 19.5 m, 21.8 m | 1.4° |
+//! | F = D, IMU noise terms only | 7.0 % | 1.232 / 0.361 m = 3.42 (19.3) | 90.0 %, 18.1 m, 19.8 m | 86.7 %, 55.9 m, 66.4 m | 47.8° |
+//! | G = D, true initial attitude and velocity | 2.3 % | 0.453 / 0.361 m = 1.26 (5.0) | 91.2 %, 15.7 m, 19.5 m | 91.7 %, 46.7 m, 66.0 m | 0 |
+//! | H = A, true initial attitude and velocity | 80.0 % | 0.950 / 0.361 m = 2.63 (8.4) | 28.7 %, 37.0 m, 16.1 m | 30.0 %, 140 m, 58.5 m | 0 |
+//!
+//! (The fix RMS of E is the float stretch's and the 5-mm white error: its antenna does
+//! not move.) Reading: no variant of today's filter meets all three bars. Two things
+//! break it, each visible on its own: (1) the initial heading — from the central
+//! difference of fixes whose antenna moves by decimetres, at 0.8 m/s, it is wrong by
+//! 48° RMS (1.4° with a rigid antenna): 3 of the 20 seeds start during the initial
+//! standstill, the antenna motion alone faking more than 0.8 m/s (heading errors 175°,
+//! 106°, 26°), the other 17 at a true 0.6–1.1 m/s with 14° RMS (worst 38.5°); every
+//! variant started there misses (c);
+//! (2) the 1-cm formal σ against 0.28-m antenna motion — the χ² gate then rejects 80 %
+//! of the fixes even from the true attitude (H), while a σ floor at the motion's σ with
+//! the true attitude (G) comes close to every bar (a 2.3 %, b 1.26×, c 91 / 92 %).
+//! Free-inertial drift of this consumer IMU without aids is tens of metres in 30 s
+//! (E: 19.5 m with a rigid antenna), so (c) is a consistency bar, not an accuracy one.
+//! Today's filter does not meet the bars, so the asserting test is ignored until the
+//! filter has σ inflation instead of rejection as its default gate and an alignment
+//! that works at walking speed.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use driftless::io::nav::{NavSolution, quality};
+use driftless::nav::attitude::Euler;
+use driftless::nav::earth::ned_offset_m;
+use driftless::nav::filter::state::POS;
+use driftless::nav::filter::{
+    FilterConfig, ForwardRun, GaussMarkov, ImuNoise, UpdateKind, run_forward,
+};
+use driftless::nav::mechanization::mechanize;
+use driftless::nav::outage::OutageWindow;
+use driftless::nav::pipeline::ImuStream;
+use driftless::nav::session::{SessionConfig, initialise_in_motion, prime_gyro_bias, run_session};
+use driftless::sim::presets::Preset;
+use driftless::sim::scenario::{ErrorTerms, Scenario, Simulation};
+
+/// Seeds of the study.
+const SEEDS: std::ops::RangeInclusive<u64> = 1..=20;
+/// Heading initialisation speed used here (module documentation).
+const MIN_SPEED_M_S: f64 = 0.8;
+/// Outage starts (s after t = 0) and lengths (s).
+const OUTAGES_15: [f64; 4] = [25.0, 55.0, 85.0, 110.0];
+const OUTAGES_30: [f64; 3] = [25.0, 65.0, 100.0];
+/// Bias Gauss–Markov correlation time of the filter, s.
+const BIAS_TAU_S: f64 = 3600.0;
+
+fn scenario_path() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios/walk-yard.toml")
+}
+
+fn scenario() -> Scenario {
+    Scenario::from_file(scenario_path()).expect("walk-yard.toml")
+}
+
+fn walk(seed: u64) -> Simulation {
+    let mut s = scenario();
+    s.seed = seed;
+    s.run().expect("walk simulation")
+}
+
+/// The simulated increments as the session's IMU stream (body = vehicle axes).
+fn imu_stream(sim: &Simulation) -> ImuStream {
+    sim.imu_stream("walk-yard.toml")
+}
+
+/// Filter noise from the `consumer` preset's numbers (`sim::presets::consumer`): white
+/// noise as the data sheet's densities (2.8 mdps/√Hz, 70 µg/√Hz); gyro in-run bias as a
+/// Gauss–Markov with T = 1 h and σ² = B² + K²T/2 (B = 8 °/h, K = 40 °/h/√h → 29 °/h) —
+/// its 0.5-°/s turn-on bias is primed by the session from the 10-s standstill at the
+/// start; accelerometer bias σ the turn-on 20 mg combined with the in-run B and K (it is
+/// not primed); scale factors σ 0.5 % (the data sheet's sensitivity tolerance), T = 1 h.
+/// The preset's 1 % cross-axis misalignment has no state in the filter.
+fn walk_noise() -> ImuNoise {
+    let p = Preset::Consumer.config();
+    let (g, a) = (&p.gyro.noise[0], &p.accel.noise[0]);
+    let in_run = |b: f64, k: f64| (b * b + k * k * BIAS_TAU_S / 2.0).sqrt();
+    let gm = |sigma: f64| GaussMarkov {
+        sigma,
+        tau_s: BIAS_TAU_S,
+    };
+    ImuNoise {
+        gyro_arw_rad_sqrt_s: g.white,
+        accel_vrw_m_s_sqrt_s: a.white,
+        gyro_bias: gm(in_run(g.bias_instability, g.rate_random_walk)),
+        accel_bias: gm(p.accel.turn_on_bias_sigma_m_s2[0]
+            .hypot(in_run(a.bias_instability, a.rate_random_walk))),
+        gyro_scale: gm(5e-3),
+        accel_scale: gm(5e-3),
+    }
+}
+
+/// The filter variants of the study (A–C), and diagnostics (D–G) that tell which
+/// part of the problem limits today's filter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Variant {
+    Chi2Gate,
+    SigmaFloor,
+    NoGate,
+    /// σ floored at the antenna motion's own horizontal σ per axis (0.3 m / 0.3 m).
+    FloorAtMotion,
+    /// The antenna rigidly on its lever arm (no antenna motion; file σ 1 cm), default gate.
+    RigidAntenna,
+    /// D on a walk whose IMU has only the preset's noise terms (no turn-on bias, scale
+    /// factor, misalignment, g-sensitivity).
+    FloorAtMotionNoiseOnly,
+    /// D started from the session's initial state with the true attitude and velocity
+    /// (what a working walking-speed alignment would give).
+    FloorAtMotionTrueHeading,
+    /// The default χ² gate started like G.
+    Chi2GateTrueHeading,
+}
+
+impl Variant {
+    const STUDY: [Variant; 3] = [Variant::Chi2Gate, Variant::SigmaFloor, Variant::NoGate];
+    const DIAGNOSTICS: [Variant; 5] = [
+        Variant::FloorAtMotion,
+        Variant::RigidAntenna,
+        Variant::FloorAtMotionNoiseOnly,
+        Variant::FloorAtMotionTrueHeading,
+        Variant::Chi2GateTrueHeading,
+    ];
+
+    fn label(self) -> &'static str {
+        match self {
+            Variant::Chi2Gate => "A default χ² gate",
+            Variant::SigmaFloor => "B σ floor 0.1/0.2 m",
+            Variant::NoGate => "C no gate",
+            Variant::FloorAtMotion => "D σ floor 0.3/0.3 m",
+            Variant::RigidAntenna => "E rigid antenna, χ² gate",
+            Variant::FloorAtMotionNoiseOnly => "F = D, IMU noise terms only",
+            Variant::FloorAtMotionTrueHeading => "G = D, true initial attitude",
+            Variant::Chi2GateTrueHeading => "H = A, true initial attitude",
+        }
+    }
+
+    fn config(self, lever_b_m: [f64; 3]) -> SessionConfig {
+        let mut c = SessionConfig::new(FilterConfig::new(walk_noise(), lever_b_m));
+        c.min_speed_m_s = MIN_SPEED_M_S;
+        match self {
+            Variant::Chi2Gate | Variant::RigidAntenna | Variant::Chi2GateTrueHeading => {}
+            Variant::SigmaFloor => c.sigma_floor_m = Some((0.1, 0.2)),
+            Variant::NoGate => c.filter.chi2_gate = None,
+            Variant::FloorAtMotion
+            | Variant::FloorAtMotionNoiseOnly
+            | Variant::FloorAtMotionTrueHeading => c.sigma_floor_m = Some((0.3, 0.3)),
+        }
+        c
+    }
+
+    /// The walk of this variant for a seed.
+    fn walk(self, seed: u64) -> Simulation {
+        let mut s = scenario();
+        s.seed = seed;
+        match self {
+            Variant::RigidAntenna => {
+                s.gnss.as_mut().expect("[gnss]").correlated_sigma_ned_m = [0.0; 3];
+            }
+            Variant::FloorAtMotionNoiseOnly => s.imu.errors = ErrorTerms::Noise,
+            _ => {}
+        }
+        s.run().expect("walk simulation")
+    }
+}
+
+/// Index of the truth sample at `t` (the truth is at the IMU rate on the same clock).
+fn truth_index(truth: &NavSolution, t: f64) -> usize {
+    let dt = truth.time_s[1] - truth.time_s[0];
+    let k = ((t - truth.time_s[0]) / dt).round() as usize;
+    assert!(
+        (truth.time_s[k] - t).abs() < 1e-6,
+        "no truth sample at {t} s"
+    );
+    k
+}
+
+/// NED error of each fix against the true antenna (truth moved by C_bn·l).
+fn fix_errors(sim: &Simulation) -> Vec<[f64; 3]> {
+    let (g, truth) = (sim.gnss.as_ref().expect("GNSS"), &sim.truth);
+    (0..g.len())
+        .map(|i| {
+            let k = truth_index(truth, g.time_s[i]);
+            let [r, p, y] = truth.roll_pitch_yaw_rad[k];
+            let c_bn = Euler {
+                roll_rad: r,
+                pitch_rad: p,
+                yaw_rad: y,
+            }
+            .to_dcm();
+            let l_n = c_bn.mul_vec(sim.lever_arm_b_m);
+            let d = ned_offset_m(
+                (truth.lat_rad[k], truth.lon_rad[k], truth.height_m[k]),
+                (g.lat_rad[i], g.lon_rad[i], g.height_m[i]),
+            );
+            [d[0] - l_n[0], d[1] - l_n[1], d[2] - l_n[2]]
+        })
+        .collect()
+}
+
+/// One end-of-outage figure: horizontal error and its bound 3·√(σ_N² + σ_E²), m.
+#[derive(Clone, Copy, Debug)]
+struct OutageEnd {
+    error_m: f64,
+    sigma_h_m: f64,
+}
+
+impl OutageEnd {
+    fn covered(&self) -> bool {
+        self.error_m <= 3.0 * self.sigma_h_m
+    }
+}
+
+/// The figures of one seed and variant.
+#[derive(Clone, Debug, Default)]
+struct SeedFigures {
+    accepted: usize,
+    rejected: usize,
+    forced: usize,
+    /// Σ e² and count of the one-step prediction errors.
+    pred_ss: f64,
+    pred_n: usize,
+    /// Σ e² and count of the fix errors over the same span.
+    fix_ss: f64,
+    fix_n: usize,
+    ends_15: Vec<OutageEnd>,
+    ends_30: Vec<OutageEnd>,
+    /// Heading error of the initial state against the truth, deg.
+    init_yaw_err_deg: f64,
+}
+
+/// A forward run and its full-GNSS figure (Σ e² and count of the one-step prediction
+/// errors, `SessionResult::horizontal_rms_m`'s definition).
+struct Forward {
+    run: ForwardRun,
+    t_init: f64,
+    init_yaw_rad: f64,
+    pred_ss: f64,
+    pred_n: usize,
+}
+
+/// The session on the walk; with `true_attitude`, the session's own steps (σ floor,
+/// gyro priming, in-motion initial state) with the initial attitude and velocity
+/// replaced by the truth, run by `run_forward` (the one-step figure then counted here
+/// like the session counts it: accepted position fixes from `converge_s` after the
+/// start, outside each outage and `reconverge_s` after it).
+fn forward(imu: &ImuStream, sim: &Simulation, cfg: &SessionConfig, true_attitude: bool) -> Forward {
+    let g = sim.gnss.as_ref().expect("GNSS");
+    if !true_attitude {
+        let r = run_session(imu, g, cfg).expect("session");
+        let (rms, n) = r.horizontal_rms_m.unwrap_or((0.0, 0));
+        return Forward {
+            t_init: r.init.nav.time_s,
+            init_yaw_rad: Euler::from_dcm(&r.init.nav.q_bn.to_dcm()).yaw_rad,
+            pred_ss: rms * rms * n as f64,
+            pred_n: n,
+            run: r.run,
+        };
+    }
+    let mut floored = g.clone();
+    if let Some((h, v)) = cfg.sigma_floor_m {
+        for s in &mut floored.sigma_ned_m {
+            *s = [s[0].max(h), s[1].max(h), s[2].max(v)];
+        }
+    }
+    let primed = prime_gyro_bias(imu, cfg.static_prime_s);
+    let mut init = initialise_in_motion(imu, &floored, cfg, primed).expect("initial state");
+    let k = truth_index(&sim.truth, init.nav.time_s);
+    let [r, p, y] = sim.truth.roll_pitch_yaw_rad[k];
+    init.nav.q_bn = Euler {
+        roll_rad: r,
+        pitch_rad: p,
+        yaw_rad: y,
+    }
+    .to_quat();
+    init.nav.vel_ned_m_s = sim.truth.vel_ned_m_s[k];
+    let mut fcfg = cfg.filter.clone();
+    fcfg.outages_s = cfg.outages.iter().map(|w| (w.start_s, w.end_s)).collect();
+    let run = run_forward(&imu.epochs, &floored, init, &fcfg).expect("forward run");
+    let t0 = init.nav.time_s;
+    let excluded = |t: f64| {
+        t < t0 + cfg.converge_s
+            || cfg
+                .outages
+                .iter()
+                .any(|w| t >= w.start_s && t <= w.end_s + cfg.reconverge_s)
+    };
+    let (mut pred_ss, mut pred_n) = (0.0, 0usize);
+    for o in run.updates.iter().flat_map(|u| u.outcomes.iter()) {
+        if o.kind == UpdateKind::Position && o.accepted && !excluded(o.time_s) {
+            pred_ss += o.innovation[0].powi(2) + o.innovation[1].powi(2);
+            pred_n += 1;
+        }
+    }
+    Forward {
+        run,
+        t_init: t0,
+        init_yaw_rad: y,
+        pred_ss,
+        pred_n,
+    }
+}
+
+/// End-of-outage figures of a run with the given windows (s after t = 0).
+fn outage_ends(
+    imu: &ImuStream,
+    sim: &Simulation,
+    cfg: &SessionConfig,
+    true_attitude: bool,
+    starts: &[f64],
+    len_s: f64,
+) -> Vec<OutageEnd> {
+    let g = sim.gnss.as_ref().expect("GNSS");
+    let t0 = g.time_s[0];
+    let mut cfg = cfg.clone();
+    cfg.outages = starts
+        .iter()
+        .map(|&a| OutageWindow {
+            start_s: t0 + a,
+            end_s: t0 + a + len_s,
+        })
+        .collect();
+    let r = forward(imu, sim, &cfg, true_attitude);
+    cfg.outages
+        .iter()
+        .map(|w| {
+            let e = r
+                .run
+                .epochs
+                .iter()
+                .rev()
+                .find(|e| e.nav.time_s < w.end_s - 1e-6)
+                .expect("an epoch inside the window");
+            let k = truth_index(&sim.truth, e.nav.time_s);
+            let d = ned_offset_m(
+                (
+                    sim.truth.lat_rad[k],
+                    sim.truth.lon_rad[k],
+                    sim.truth.height_m[k],
+                ),
+                (e.nav.lat_rad, e.nav.lon_rad, e.nav.height_m),
+            );
+            OutageEnd {
+                error_m: d[0].hypot(d[1]),
+                sigma_h_m: e.std[POS].hypot(e.std[POS + 1]),
+            }
+        })
+        .collect()
+}
+
+fn seed_figures(sim: &Simulation, variant: Variant) -> SeedFigures {
+    let imu = imu_stream(sim);
+    let g = sim.gnss.as_ref().expect("GNSS");
+    let cfg = variant.config(sim.lever_arm_b_m);
+    let true_att = matches!(
+        variant,
+        Variant::FloorAtMotionTrueHeading | Variant::Chi2GateTrueHeading
+    );
+    let full = forward(&imu, sim, &cfg, true_att);
+    let from = full.t_init + cfg.converge_s;
+    let (mut fix_ss, mut fix_n) = (0.0, 0usize);
+    for (t, e) in g.time_s.iter().zip(fix_errors(sim)) {
+        if *t >= from {
+            fix_ss += e[0] * e[0] + e[1] * e[1];
+            fix_n += 1;
+        }
+    }
+    let k = truth_index(&sim.truth, full.t_init);
+    let dyaw = (full.init_yaw_rad - sim.truth.roll_pitch_yaw_rad[k][2]).to_degrees();
+    SeedFigures {
+        init_yaw_err_deg: (dyaw + 180.0).rem_euclid(360.0) - 180.0,
+        accepted: full.run.gnss_accepted,
+        rejected: full.run.gnss_rejected,
+        forced: full.run.gnss_forced,
+        pred_ss: full.pred_ss,
+        pred_n: full.pred_n,
+        fix_ss,
+        fix_n,
+        ends_15: outage_ends(&imu, sim, &cfg, true_att, &OUTAGES_15, 15.0),
+        ends_30: outage_ends(&imu, sim, &cfg, true_att, &OUTAGES_30, 30.0),
+    }
+}
+
+/// Pooled figures of one variant over the seeds.
+#[derive(Clone, Copy, Debug)]
+struct Pooled {
+    rejected_share: f64,
+    forced: usize,
+    pred_rms_m: f64,
+    fix_rms_m: f64,
+    worst_seed_ratio: f64,
+    /// (share covered, mean error, mean bound, mean e²/σ²) for 15 s and 30 s.
+    ends_15: (f64, f64, f64, f64),
+    ends_30: (f64, f64, f64, f64),
+    /// RMS initial heading error, deg.
+    init_yaw_rms_deg: f64,
+}
+
+impl Pooled {
+    fn ratio(&self) -> f64 {
+        self.pred_rms_m / self.fix_rms_m
+    }
+}
+
+fn pool(figs: &[SeedFigures]) -> Pooled {
+    let sum = |f: fn(&SeedFigures) -> f64| figs.iter().map(f).sum::<f64>();
+    let ends = |all: Vec<OutageEnd>| {
+        let n = all.len() as f64;
+        (
+            all.iter().filter(|e| e.covered()).count() as f64 / n,
+            all.iter().map(|e| e.error_m).sum::<f64>() / n,
+            all.iter().map(|e| 3.0 * e.sigma_h_m).sum::<f64>() / n,
+            all.iter()
+                .map(|e| (e.error_m / e.sigma_h_m).powi(2))
+                .sum::<f64>()
+                / n,
+        )
+    };
+    let (acc, rej) = (sum(|f| f.accepted as f64), sum(|f| f.rejected as f64));
+    Pooled {
+        rejected_share: rej / (acc + rej),
+        forced: figs.iter().map(|f| f.forced).sum(),
+        pred_rms_m: (sum(|f| f.pred_ss) / sum(|f| f.pred_n as f64)).sqrt(),
+        fix_rms_m: (sum(|f| f.fix_ss) / sum(|f| f.fix_n as f64)).sqrt(),
+        worst_seed_ratio: figs
+            .iter()
+            .map(|f| (f.pred_ss / f.pred_n as f64).sqrt() / (f.fix_ss / f.fix_n as f64).sqrt())
+            .fold(0.0, f64::max),
+        ends_15: ends(figs.iter().flat_map(|f| f.ends_15.clone()).collect()),
+        ends_30: ends(figs.iter().flat_map(|f| f.ends_30.clone()).collect()),
+        init_yaw_rms_deg: (sum(|f| f.init_yaw_err_deg.powi(2)) / figs.len() as f64).sqrt(),
+    }
+}
+
+/// Runs the study for the given variants and prints one table row each.
+fn study(variants: &[Variant]) -> Vec<Pooled> {
+    let clock = Instant::now();
+    let sims: Vec<Simulation> = SEEDS.map(walk).collect();
+    eprintln!(
+        "{} walks simulated in {:.1} s",
+        sims.len(),
+        clock.elapsed().as_secs_f64()
+    );
+    let needs_own =
+        |v: Variant| matches!(v, Variant::RigidAntenna | Variant::FloorAtMotionNoiseOnly);
+    eprintln!(
+        "| variant | (a) rejected | forced | (b) pred RMS / fix RMS = ratio (worst seed) | \
+         (c) 15 s: covered, mean e_h, mean 3σ_h, mean e²/σ² | 30 s: covered, mean e_h, mean 3σ_h, mean e²/σ² | initial heading error RMS |"
+    );
+    variants
+        .iter()
+        .map(|&v| {
+            let c = Instant::now();
+            let figs: Vec<SeedFigures> = if needs_own(v) {
+                SEEDS.map(|seed| seed_figures(&v.walk(seed), v)).collect()
+            } else {
+                sims.iter().map(|s| seed_figures(s, v)).collect()
+            };
+            let p = pool(&figs);
+            let row = |e: (f64, f64, f64, f64)| {
+                format!(
+                    "{:.1} %, {:.2} m, {:.2} m, {:.1}",
+                    100.0 * e.0,
+                    e.1,
+                    e.2,
+                    e.3
+                )
+            };
+            eprintln!(
+                "| {} | {:.2} % | {} | {:.3} / {:.3} m = {:.2} ({:.2}) | {} | {} | {:.1}° | ({:.1} s)",
+                v.label(),
+                100.0 * p.rejected_share,
+                p.forced,
+                p.pred_rms_m,
+                p.fix_rms_m,
+                p.ratio(),
+                p.worst_seed_ratio,
+                row(p.ends_15),
+                row(p.ends_30),
+                p.init_yaw_rms_deg,
+                c.elapsed().as_secs_f64()
+            );
+            p
+        })
+        .collect()
+}
+
+/// What holds today: the walk is the scenario's (yard, speed, stops, file σ 1 cm, a
+/// float stretch, antenna motion in the 5–60-cm band), its truth agrees with its ideal
+/// increments, and today's filter runs through it to the end.
+#[test]
+fn walk_simulation_matches_the_scenario_and_the_filter_runs() {
+    let sim = walk(1);
+    let g = sim.gnss.as_ref().expect("GNSS");
+    let truth = &sim.truth;
+    let n = truth.time_s.len();
+    let duration = truth.time_s[n - 1] - truth.time_s[0];
+    assert!((duration - 153.96).abs() < 1e-6, "{duration} s");
+
+    // The yard: every truth position inside a 20 × 20 m box; walking speed 1.2 m/s (to
+    // the scaled-coordinate approximation, 1e-7 relative); standing still at the start
+    // (10 s), twice on the way (4 s, 5 s) and at the end (5 s).
+    let o = (truth.lat_rad[0], truth.lon_rad[0], truth.height_m[0]);
+    let (mut n_lo, mut n_hi, mut e_lo, mut e_hi) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut v_max = 0.0f64;
+    let (mut still, mut stops) = (0usize, Vec::new());
+    for k in 0..n {
+        let d = ned_offset_m(o, (truth.lat_rad[k], truth.lon_rad[k], truth.height_m[k]));
+        (n_lo, n_hi) = (n_lo.min(d[0]), n_hi.max(d[0]));
+        (e_lo, e_hi) = (e_lo.min(d[1]), e_hi.max(d[1]));
+        let v = truth.vel_ned_m_s[k];
+        let vh = v[0].hypot(v[1]);
+        v_max = v_max.max(vh);
+        if vh == 0.0 && v[2] == 0.0 {
+            still += 1;
+        } else if still > 0 {
+            stops.push(still as f64 * 0.01);
+            still = 0;
+        }
+    }
+    stops.push(still as f64 * 0.01);
+    eprintln!(
+        "walk: {duration:.1} s, box {:.1} m N × {:.1} m E, top speed {v_max:.3} m/s, stops {stops:?} s",
+        n_hi - n_lo,
+        e_hi - e_lo
+    );
+    assert!(n_hi - n_lo <= 20.0 && e_hi - e_lo <= 20.0);
+    assert!((v_max - 1.2).abs() < 1e-6, "{v_max}");
+    assert_eq!(stops.len(), 4, "{stops:?}");
+    assert!(
+        stops[0] >= 10.0 && stops[1..].iter().all(|&s| s >= 4.0),
+        "{stops:?}"
+    );
+
+    // 4 Hz fixes; fixed ones say 1 cm / 2 cm, the 57 float ones (132 … 146 s) 0.15 / 0.3 m.
+    assert!((g.time_s[1] - g.time_s[0] - 0.25).abs() < 1e-9);
+    assert_eq!(g.len(), (duration * 4.0).floor() as usize + 1);
+    let t0 = g.time_s[0];
+    let float: Vec<usize> = (0..g.len())
+        .filter(|&i| g.quality[i] == quality::FLOAT)
+        .collect();
+    assert_eq!(float.len(), 57);
+    assert!((g.time_s[float[0]] - t0 - 132.0).abs() < 1e-9);
+    for i in 0..g.len() {
+        let want = if g.quality[i] == quality::FLOAT {
+            [0.15, 0.15, 0.3]
+        } else {
+            assert_eq!(g.quality[i], quality::FIX);
+            [0.01, 0.01, 0.02]
+        };
+        assert_eq!(g.sigma_ned_m[i], want);
+    }
+
+    // The true error of the fixed fixes: the antenna motion, RMS per horizontal axis
+    // √(0.2² + 0.005²) = 0.2 m (≈ 50 correlation times: ±15 % allowed), its horizontal
+    // magnitude mostly within 5–60 cm; the float fixes are worse.
+    let errs = fix_errors(&sim);
+    let mut h: Vec<f64> = (0..g.len())
+        .filter(|&i| g.quality[i] == quality::FIX)
+        .map(|i| errs[i][0].hypot(errs[i][1]))
+        .collect();
+    let rms = (h.iter().map(|x| x * x).sum::<f64>() / h.len() as f64).sqrt();
+    h.sort_by(f64::total_cmp);
+    let pct = |p: f64| h[((h.len() - 1) as f64 * p).round() as usize];
+    eprintln!(
+        "antenna motion: horizontal RMS {rms:.3} m, 5 / 50 / 95 % {:.3} / {:.3} / {:.3} m",
+        pct(0.05),
+        pct(0.5),
+        pct(0.95)
+    );
+    let want = 2f64.sqrt() * 0.2f64.hypot(0.005);
+    assert!((rms / want - 1.0).abs() < 0.15, "{rms} vs {want}");
+    assert!(pct(0.05) >= 0.03 && pct(0.95) <= 0.6);
+
+    // The float error is on top: without the float window the same seed gives the same
+    // fixes outside it, and inside fixes that differ by a slowly varying offset (the
+    // extra Gauss–Markov error, τ 20 s: lag-one correlation e^(−0.25/20) = 0.988).
+    let mut fixed_only = scenario();
+    fixed_only.seed = 1;
+    fixed_only
+        .gnss
+        .as_mut()
+        .expect("[gnss]")
+        .degraded_windows
+        .clear();
+    let g2 = fixed_only
+        .run()
+        .expect("walk without float")
+        .gnss
+        .expect("GNSS");
+    let extra: Vec<[f64; 3]> = (0..g.len())
+        .map(|i| {
+            ned_offset_m(
+                (g2.lat_rad[i], g2.lon_rad[i], g2.height_m[i]),
+                (g.lat_rad[i], g.lon_rad[i], g.height_m[i]),
+            )
+        })
+        .collect();
+    for i in 0..g.len() {
+        if g.quality[i] == quality::FIX {
+            assert_eq!(
+                (g.lat_rad[i], g.lon_rad[i], g.height_m[i]),
+                (g2.lat_rad[i], g2.lon_rad[i], g2.height_m[i])
+            );
+        }
+    }
+    let x: Vec<f64> = float.iter().map(|&i| extra[i][0]).collect();
+    let (m, c0) = (
+        x.iter().sum::<f64>() / x.len() as f64,
+        x.iter().map(|v| v * v).sum::<f64>(),
+    );
+    let c1: f64 = x.windows(2).map(|w| w[0] * w[1]).sum();
+    let h_extra = float
+        .iter()
+        .map(|&i| extra[i][0].hypot(extra[i][1]))
+        .fold(0.0, f64::max);
+    eprintln!(
+        "float stretch: extra error north mean {m:.3} m, largest horizontal {h_extra:.3} m, lag-one correlation {:.3}",
+        c1 / c0
+    );
+    assert!(h_extra > 0.05 && c1 / c0 > 0.9, "{h_extra} {}", c1 / c0);
+
+    // The truth agrees with the increments: the same walk without sensor errors,
+    // mechanized from the initial truth, ends near the final truth — 3 cm at 100 Hz,
+    // the mechanization's own error on the sway and turn joins (two-sample coning and
+    // sculling), which falls with the interval: < 1 cm and > 3× smaller at 400 Hz.
+    let end_error = |rate_hz: f64| {
+        let mut ideal = scenario();
+        ideal.imu.errors = ErrorTerms::None;
+        ideal.imu.rate_hz = rate_hz;
+        let clean = ideal.run().expect("error-free walk");
+        let incs = clean.imu.to_increments();
+        let mut s = clean.initial;
+        let mut prev = incs[0];
+        for inc in &incs {
+            s = mechanize(&s, &prev, inc);
+            prev = *inc;
+        }
+        let t = &clean.truth;
+        let k = truth_index(t, s.time_s);
+        let d = ned_offset_m(
+            (t.lat_rad[k], t.lon_rad[k], t.height_m[k]),
+            (s.lat_rad, s.lon_rad, s.height_m),
+        );
+        d[0].hypot(d[1]).hypot(d[2])
+    };
+    let (e100, e400) = (end_error(100.0), end_error(400.0));
+    eprintln!(
+        "error-free mechanization over the walk: end error {e100:.4} m at 100 Hz, {e400:.4} m at 400 Hz"
+    );
+    assert!(
+        e100 < 0.05 && e400 < 0.01 && e400 < e100 / 3.0,
+        "{e100} {e400}"
+    );
+
+    // Today's filter (default χ² gate, walking-speed initialisation) runs to the end.
+    let imu = imu_stream(&sim);
+    let cfg = Variant::Chi2Gate.config(sim.lever_arm_b_m);
+    let r = run_session(&imu, g, &cfg).expect("session on the walk");
+    let last = r.run.epochs.last().expect("epochs").nav.time_s;
+    assert!((last - imu.epochs.last().expect("IMU").time_s).abs() < 1e-9);
+    assert!(r.primed_gyro_bias_rad_s.is_some(), "static start not used");
+    assert!(
+        r.init.nav.time_s - t0 < 12.0,
+        "initialised at {}",
+        r.init.nav.time_s - t0
+    );
+    let (rms, count) = r.horizontal_rms_m.expect("prediction errors");
+    assert!(rms.is_finite() && count > 0, "{rms} over {count}");
+    eprintln!(
+        "default filter: initialised {:.2} s after the first fix, {} accepted, {} rejected, {} forced, one-step RMS {rms:.3} m",
+        r.init.nav.time_s - t0,
+        r.run.gnss_accepted,
+        r.run.gnss_rejected,
+        r.run.gnss_forced
+    );
+}
+
+/// The study's bars under the default filter (module documentation).
+#[test]
+#[ignore = "waits for the filter's robust default gate (σ inflation instead of χ² rejection) \
+            and walking-speed alignment: today's χ² gate rejects most fixes of a hand-held \
+            RTK antenna and the outage ends miss 3σ (table in VALIDATION.md)"]
+fn walk_study_meets_the_bars() {
+    let p = study(&[Variant::Chi2Gate])[0];
+    assert!(
+        p.rejected_share < 0.02,
+        "(a) {:.2} % of the fixes rejected by the gate (bar < 2 %)",
+        100.0 * p.rejected_share
+    );
+    assert!(
+        p.ratio() <= 1.2,
+        "(b) one-step prediction RMS {:.3} m is {:.2}× the fixes' RMS error {:.3} m (bar ≤ 1.2×)",
+        p.pred_rms_m,
+        p.ratio(),
+        p.fix_rms_m
+    );
+    for (len, e) in [(15, p.ends_15), (30, p.ends_30)] {
+        assert!(
+            e.0 >= 0.9,
+            "(c) {len}-s outages: {:.1} % of the ends within 3·√(σN² + σE²) (bar ≥ 90 %)",
+            100.0 * e.0
+        );
+    }
+}
+
+/// The three filter variants side by side (hand-run; the table in VALIDATION.md):
+/// `cargo test --release -p driftless --test nav_walk measure_ -- --ignored --nocapture`.
+#[test]
+#[ignore = "measurement: prints the variant table"]
+fn measure_walk_filter_variants() {
+    let clock = Instant::now();
+    let rows = study(&Variant::STUDY);
+    assert_eq!(rows.len(), 3);
+    if std::env::var_os("WALK_DIAGNOSTICS").is_some() {
+        study(&Variant::DIAGNOSTICS);
+    }
+    eprintln!("total {:.1} s", clock.elapsed().as_secs_f64());
+}
