@@ -23,7 +23,9 @@ pub mod rtklib;
 pub mod track;
 pub mod types;
 
-pub use gpstime::GpsTime;
+pub use gpstime::{
+    GpsTime, LEAP_SECONDS, ParseTimeBaseError, TimeBase, TimeBaseError, gps_minus_utc_s,
+};
 pub use kfgins::{
     GnssReadOptions, KfGinsOutputWriter, ZeroSigma, read_kfgins_gnss, read_kfgins_gnss_file,
     read_kfgins_imu, read_kfgins_imu_file, write_kfgins_gnss, write_kfgins_imu,
