@@ -1004,3 +1004,73 @@ fn rates_csv_week_rollover() {
         "{e}"
     );
 }
+
+/// The drive recording with its first and last records cut as a logger that starts and
+/// stops mid-line leaves them (first record: its first 6 bytes gone; last: stopped after
+/// 20 bytes, no line end) reads as the whole file minus those two epochs, at the same GPS
+/// times (the tick-mapping anchors are kept), with two notes; the GNSS `.pos` cut inside its
+/// last epoch line reads as the whole file minus that epoch.
+#[test]
+#[ignore = "needs shared data"]
+fn drive_0708_cut_edges_match_whole() {
+    use driftless::io::nav::{FposSize, read_rtklib_pos, read_rtklib_tag_file};
+    use driftless::nav::pipeline::imu_from_tagged_csv;
+    let dir = data_dir().join("drive/drive_0708");
+    let csv = std::fs::read_to_string(dir.join("imu_1934.csv")).unwrap();
+    let tag = read_rtklib_tag_file(dir.join("imu_1934.csv.tag"), FposSize::Auto).unwrap();
+    let opts = TaggedCsvOptions::drive_0708();
+    let whole = imu_from_tagged_csv(csv.as_bytes(), "imu.csv", &tag, &opts).unwrap();
+    assert!(whole.notes.is_empty());
+    let lines: Vec<&str> = csv.lines().collect();
+    let n = lines.len();
+    let mut cut = lines[0][6..].to_string();
+    for l in &lines[1..n - 1] {
+        cut.push('\n');
+        cut.push_str(l);
+    }
+    cut.push('\n');
+    cut.push_str(&lines[n - 1][..20]);
+    let s = imu_from_tagged_csv(cut.as_bytes(), "imu.csv", &tag, &opts).unwrap();
+    assert_eq!(s.len(), whole.len() - 2);
+    assert_eq!(s.notes.len(), 2, "{:?}", s.notes);
+    assert!(s.notes[0].starts_with("imu.csv:1: dropped the first record"));
+    assert!(s.notes[1].starts_with(&format!("imu.csv:{n}: dropped the last record")));
+    let mut max_dt = 0f64;
+    for (a, b) in s.epochs.iter().zip(&whole.epochs[1..]) {
+        max_dt = max_dt.max((a.time_s - b.time_s).abs());
+    }
+    // The end anchor is estimated (last kept tick + median interval): the stretch mapping
+    // then errs by the difference between the real last interval and the median.
+    let real_last = lines[n - 1]
+        .rsplit(',')
+        .next()
+        .unwrap()
+        .parse::<f64>()
+        .unwrap();
+    let prev = lines[n - 2]
+        .rsplit(',')
+        .next()
+        .unwrap()
+        .parse::<f64>()
+        .unwrap();
+    let jitter_ms = (real_last - prev - whole.nominal_dt_s * 1e3).abs();
+    println!(
+        "cut edges: max |Δt| vs whole file {max_dt:.3e} s (last interval off the median by {jitter_ms} ms)"
+    );
+    assert!(max_dt <= (jitter_ms + 0.1) * 1e-3, "{max_dt}");
+    // Rates (Δv/Δt) equal sample for sample.
+    for (a, b) in s.epochs.iter().zip(&whole.epochs[1..]).skip(1) {
+        for k in 0..3 {
+            let (fa, fb) = (a.dvel_m_s[k] / a.dt_s, b.dvel_m_s[k] / b.dt_s);
+            assert!((fa - fb).abs() < 1e-6 * fb.abs().max(1.0), "{fa} {fb}");
+        }
+    }
+    let pos = std::fs::read_to_string(dir.join("gnss_1934_sf.pos")).unwrap();
+    let gnss_whole = read_rtklib_pos(pos.as_bytes(), "g.pos", &GnssReadOptions::default()).unwrap();
+    let trimmed = pos.trim_end();
+    let cut_pos = &trimmed[..trimmed.len() - 15];
+    let g = read_rtklib_pos(cut_pos.as_bytes(), "g.pos", &GnssReadOptions::default()).unwrap();
+    assert_eq!(g.len(), gnss_whole.len() - 1);
+    assert_eq!(g.time_s[..], gnss_whole.time_s[..g.len()]);
+    assert_eq!(g.notes.len(), 1, "{:?}", g.notes);
+}

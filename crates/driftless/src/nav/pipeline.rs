@@ -860,14 +860,21 @@ pub fn imu_from_tagged_csv(
     Ok(s)
 }
 
-/// The tick (last field, ms) of the first data line of a tagged CSV, when that line is not
-/// a whole record (fewer than 7 fields, or a first field that is not a number) and its last
-/// field is a number: the line end of a record cut at its start is intact.
+/// The tick (last field, ms) of the first data line of a tagged CSV (the first line whose
+/// last field is a number, so a header is passed over), when that line is not a whole
+/// record (fewer than 7 fields, or a first field that is not a number): the line end of a
+/// record cut at its start, with its tick, is intact.
 fn cut_first_tick(csv: &[u8]) -> Option<f64> {
+    let last_is_number = |l: &[u8]| {
+        std::str::from_utf8(l)
+            .ok()
+            .and_then(|t| t.rsplit(',').next())
+            .is_some_and(|f| f.trim().parse::<f64>().is_ok())
+    };
     let line = csv
         .split(|&b| b == b'\n')
         .map(|l| l.trim_ascii())
-        .find(|l| !l.is_empty() && !l.starts_with(b"#"))?;
+        .find(|l| !l.is_empty() && !l.starts_with(b"#") && last_is_number(l))?;
     let text = std::str::from_utf8(line).ok()?;
     let fields: Vec<&str> = text.split(',').map(str::trim).collect();
     let whole = fields.len() >= TAGGED_CSV_COLUMNS.len()

@@ -210,7 +210,16 @@ impl TimeBase {
             return Ok((None, Vec::new()));
         };
         let first_gps = self.gps_seconds(first, None)?.unwrap_or(0.0);
-        let week0 = (first_gps / SECONDS_PER_WEEK).floor();
+        let leap0 = match self {
+            TimeBase::UtcUnix => f64::from(gps_minus_utc_s(first)?),
+            _ => 0.0,
+        };
+        let mut week0 = (first_gps / SECONDS_PER_WEEK).floor();
+        // The rounded quotient may land on the next week by a hair: the first stamp's
+        // seconds of week, computed exactly below, must be ≥ 0.
+        if (first - (week0 * SECONDS_PER_WEEK + GPS_EPOCH_UNIX_S)) + leap0 < 0.0 {
+            week0 -= 1.0;
+        }
         let Ok(w) = u16::try_from(week0 as i64) else {
             return Err(TimeBaseError::PastLastWeek {
                 value_s: first,

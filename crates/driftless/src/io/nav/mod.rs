@@ -3,7 +3,8 @@
 //! Readers turn files into the typed, columnar records of [`types`] (SI units, names with
 //! units), converting units at this edge only; writers do the reverse. Every bad input gives
 //! one [`LogError`] naming the file, line and column; readers never return NaN and never
-//! return partial data.
+//! return partial data, except that a truncated first or last record (what a logger that
+//! starts or stops mid-line leaves) is dropped and reported in the result's `notes`.
 //!
 //! * [`kfgins`]: the text formats of KF-GINS (i2Nav-WHU/KF-GINS, GPL-3.0; formats learnt from
 //!   its README, `src/fileio/*` and `src/kf_gins.cpp`, no code taken): IMU increments,
