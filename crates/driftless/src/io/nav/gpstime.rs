@@ -110,7 +110,7 @@ pub fn gps_minus_utc_s(unix_utc_s: f64) -> Result<i32, TimeBaseError> {
 }
 
 /// What an IMU log's time column counts. The navigation filter works in GPS seconds of week;
-/// [`TimeBase::to_gps`] converts a time stamp of any base to GPS week + seconds of week.
+/// [`TimeBase::to_gps_week_seconds`] converts stamps of any base to GPS week + seconds of week.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TimeBase {
     /// GPS seconds of week (GPST, no leap seconds), the filter's own time (`gps-sow`).
