@@ -50,6 +50,7 @@ fn kf_gins_config_runs_unchanged_and_writes_its_three_files() {
         time_s: (0..n).map(|k| t0 + (k + 1) as f64 * dt).collect(),
         dtheta_rad: incs.iter().map(|i| i.dtheta_rad).collect(),
         dvel_m_s: incs.iter().map(|i| i.dvel_m_s).collect(),
+        ..Default::default()
     };
     let gnss = turn_fixes(&turn, t0);
     let file = |p: &str| std::fs::File::create(dir.join(p)).unwrap();
@@ -404,6 +405,7 @@ fn auto_outages_are_chosen_on_the_track_or_refused() {
         time_s: (0..n).map(|k| t0 + (k + 1) as f64 * dt).collect(),
         dtheta_rad: incs.iter().map(|i| i.dtheta_rad).collect(),
         dvel_m_s: incs.iter().map(|i| i.dvel_m_s).collect(),
+        ..Default::default()
     };
     let file = |p: &str| std::fs::File::create(dir.join(p)).unwrap();
     write_kfgins_imu(file("imu.txt"), "imu.txt", &imu).unwrap();

@@ -299,9 +299,170 @@ fn error_ragged_rows() {
         "{e}"
     );
     assert_eq!(e.line(), Some(3));
-    let e = err("0 1 2\n1 2 3 4\n", &timed());
+    let e = err("0 1 2\n1 2 3 4\n2 3 4\n", &timed());
     assert!(matches!(e, LogError::Ragged { found: 4, .. }), "{e}");
     assert!(e.to_string().starts_with("mem.csv:2:7:"), "{e}");
+}
+
+/// The reference row of "expected N fields (as on line K)" is itself good: a short first
+/// row is reported at its own line against the rows after it.
+#[test]
+fn ragged_first_row_cites_a_good_reference() {
+    let e = err("0 1\n1 2 3\n2 3 4\n3 4 5\n", &timed());
+    assert_eq!(
+        e.to_string(),
+        "mem.csv:1:4: row has 2 fields, expected 3 (as on line 2)"
+    );
+    // Two rows: the longer second row is the reference.
+    let e = err("# c\n0 1 2\n1 2 3 4\n", &timed());
+    assert_eq!(
+        e.to_string(),
+        "mem.csv:2:6: row has 3 fields, expected 4 (as on line 3)"
+    );
+    // Many short rows: after a dropped cut first record the next short row is an error
+    // with file, line and byte column, citing a good row.
+    let many = "1,2\n1,2\n3,4\n2,5,6\n3,7,8\n4,9,9\n";
+    let opts = timed().dropping_truncated_edges();
+    let e = err(many, &opts);
+    assert_eq!(
+        e.to_string(),
+        "mem.csv:2:4: row has 2 fields, expected 3 (as on line 4)"
+    );
+    // Strict (default): the first short row is the error, with the same reference.
+    let e = err(many, &timed());
+    assert_eq!(
+        e.to_string(),
+        "mem.csv:1:4: row has 2 fields, expected 3 (as on line 4)"
+    );
+}
+
+/// Opt-in dropping of records cut by the start or end of a recording.
+#[test]
+fn truncated_edge_records_dropped_only_when_asked() {
+    let rows: Vec<String> = (0..20)
+        .map(|i| {
+            format!(
+                "{i},{:.1},{:.1}",
+                1.5 + 0.1 * i as f64,
+                2.5 + 0.1 * i as f64
+            )
+        })
+        .collect();
+    let clean = rows.join("\n") + "\n";
+    // Cut inside the first row's first number and inside the last row's second field.
+    let mut cut_rows = rows.clone();
+    cut_rows[0] = "5,2.5".into();
+    cut_rows[19] = "19,3.".into();
+    let cut = cut_rows.join("\n");
+    let strict = err(&cut, &timed());
+    assert_eq!(
+        strict.to_string(),
+        "mem.csv:1:6: row has 2 fields, expected 3 (as on line 2)"
+    );
+    let opts = timed().dropping_truncated_edges();
+    let all = read_text_bytes(clean.as_bytes(), "mem.csv", &opts).unwrap();
+    assert!(all.notes.is_empty());
+    for chunk in [64, 100, 1 << 20] {
+        let mut o = opts.clone();
+        o.chunk_bytes = chunk;
+        let log = read_text_bytes(cut.as_bytes(), "mem.csv", &o).unwrap();
+        let t: Vec<f64> = (1..19).map(f64::from).collect();
+        assert_eq!(log.time_s, Some(t), "chunk {chunk}");
+        for (c, whole) in log.channels.iter().zip(&all.channels) {
+            assert_eq!(c.values, whole.values[1..19].to_vec());
+        }
+        assert_eq!(
+            log.notes,
+            vec![
+                "mem.csv:1: dropped the first record \"5,2.5\", cut by the start of the recording: it has 2 fields, line 2 has 3".to_string(),
+                "mem.csv:20: dropped the last record \"19,3.\", cut by the end of the recording: it has 2 fields, line 2 has 3".to_string(),
+            ]
+        );
+    }
+    // A cut first number that is no number, after a header, and a cut last number.
+    let t = "t,a,b\n.5e,1.5,2.5\n1,1.6,2.6\n2,1.7,2.7\n3,1.8,2.8e";
+    let log = read_text_bytes(t.as_bytes(), "mem.csv", &opts).unwrap();
+    assert_eq!(log.len(), 2);
+    assert!(
+        log.notes[0].ends_with("its field 1 is not a number"),
+        "{:?}",
+        log.notes
+    );
+    assert!(
+        log.notes[1].starts_with("mem.csv:5: dropped the last"),
+        "{:?}",
+        log.notes
+    );
+    // Headerless, a cut first number is not mistaken for a header.
+    let t = "e-3,1.5,2.5\n1,1.6,2.6\n2,1.7,2.7\n";
+    let log = read_text_bytes(t.as_bytes(), "mem.csv", &opts).unwrap();
+    assert_eq!(log.time_s.as_deref(), Some(&[1.0, 2.0][..]));
+    assert_eq!(log.channels[0].name, "col2");
+    // The time is the last field and the file ends inside it: 2 fields whole, but the
+    // time goes back → dropped; with a line end it is a real error.
+    let opts_t = TextOptions::default()
+        .with_time(ColumnRef::Index(3), None)
+        .dropping_truncated_edges();
+    let t = "1.5,2.5,100\n1.6,2.6,101\n1.7,2.7,102\n1.8,2.8,10";
+    let log = read_text_bytes(t.as_bytes(), "mem.csv", &opts_t).unwrap();
+    assert_eq!(log.len(), 3);
+    assert!(
+        log.notes[0].ends_with(
+            "it has no line end and its time stamp 10 s does not follow the previous 102 s"
+        ),
+        "{:?}",
+        log.notes
+    );
+    let e = err(&format!("{t}\n"), &opts_t);
+    assert!(matches!(e, LogError::NonMonotonicTime { .. }), "{e}");
+    // A bad row in the middle stays an error with dropping on.
+    let e = err("0,1,2\n1,2\n2,3,4\n3,4,5\n", &opts);
+    assert!(e.to_string().starts_with("mem.csv:2:4:"), "{e}");
+    let e = err("0,1,2\n1,x,2\n2,3,4\n", &opts);
+    assert!(matches!(e, LogError::NonNumeric { .. }), "{e}");
+}
+
+/// Week + seconds of week in two columns, across a week boundary.
+#[test]
+fn week_and_seconds_of_week_columns() {
+    let t = "week,sow,g\n2399,604799.5,1\n2399,604799.75,2\n2400,0.0,3\n2400,0.25,4\n";
+    for week in [ColumnRef::Name("week".into()), ColumnRef::Index(1)] {
+        let o = TextOptions::default()
+            .with_time(ColumnRef::Name("sow".into()), None)
+            .with_week_column(week);
+        let log = read_text_bytes(t.as_bytes(), "w.csv", &o).unwrap();
+        assert_eq!(log.week, Some(2399));
+        // Seconds from the start of week 2399 keep increasing past 604 800 s.
+        assert_eq!(
+            log.time_s.as_deref(),
+            Some(&[604_799.5, 604_799.75, 604_800.0, 604_800.25][..])
+        );
+        assert_eq!(log.channels.len(), 1);
+        assert_eq!(log.channels[0].values, vec![1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(log.tau0_s, 0.25);
+    }
+    // Without the week column the restart at 0 is time going backwards.
+    let o = TextOptions::default().with_time(ColumnRef::Name("sow".into()), None);
+    let e = err(t, &o);
+    assert!(matches!(e, LogError::NonMonotonicTime { .. }), "{e}");
+    // Weeks must be whole numbers; the week column needs a time column.
+    let bad = "week,sow,g\n2399.5,1,1\n2399.5,2,1\n";
+    let o = TextOptions::default()
+        .with_time(ColumnRef::Name("sow".into()), None)
+        .with_week_column(ColumnRef::Name("week".into()));
+    let e = err(bad, &o);
+    assert_eq!(
+        e.to_string(),
+        "mem.csv:2: week 2399.5 in column 1 (week) is not a whole number in 0–65535"
+    );
+    let o = rate(1.0).with_week_column(ColumnRef::Index(1));
+    let e = err(t, &o);
+    assert!(e.to_string().contains("needs a time column"), "{e}");
+    let o = TextOptions::default()
+        .with_time(ColumnRef::Index(2), None)
+        .with_week_column(ColumnRef::Index(2));
+    let e = err(t, &o);
+    assert!(e.to_string().contains("selected twice"), "{e}");
 }
 
 #[test]

@@ -730,6 +730,7 @@ fn case_stream(
         nominal_dt_s: raw.dt_s,
         epochs,
         gaps: Vec::new(),
+        notes: Vec::new(),
     })
 }
 

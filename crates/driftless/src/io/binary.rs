@@ -479,5 +479,6 @@ fn read_impl<R: Read>(
                 duration_s: g.duration_s,
             })
             .collect(),
+        ..ImuLog::default()
     })
 }

@@ -126,7 +126,9 @@ pub enum LogError {
         found: usize,
         /// Fields on the reference row.
         expected: usize,
-        /// Line of the header or first data row that fixed the field count.
+        /// Line of the header or reference data row that fixed the field count: the first
+        /// data row, or the first of the rows after it when the first row is shorter than
+        /// most of them — never the offending row itself.
         reference_line: usize,
     },
     /// A time stamp smaller than its predecessor.

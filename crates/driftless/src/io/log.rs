@@ -74,6 +74,14 @@ pub struct ImuLog {
     /// Time gaps found by the reader (with `GapPolicy::Split` or `GapPolicy::Bridge`), in
     /// row order; callers should warn about them. Empty when there were none.
     pub gaps: Vec<TimeGap>,
+    /// Week number of the first row when the time came as week + seconds of week
+    /// ([`crate::io::TextOptions::week_column`]); `time_s` then counts seconds from the
+    /// start of that week. `None` otherwise.
+    pub week: Option<u16>,
+    /// What the reader dropped and why (a truncated first or last record, see
+    /// [`crate::io::TextOptions::drop_truncated_edges`]), one message per item, naming file
+    /// and line, for the caller to show. Empty when nothing was dropped.
+    pub notes: Vec<String>,
 }
 
 impl ImuLog {
@@ -100,6 +108,8 @@ impl ImuLog {
                 Vec::new()
             },
             gaps: Vec::new(),
+            week: None,
+            notes: Vec::new(),
         }
     }
     /// The channel with this name, if any.

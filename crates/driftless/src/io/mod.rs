@@ -16,6 +16,7 @@ pub mod autopilot;
 pub mod binary;
 #[cfg(feature = "autopilot-logs")]
 pub mod dataflash;
+pub(crate) mod edge;
 pub mod error;
 pub mod log;
 pub mod nav;

@@ -10,8 +10,25 @@
 //! * Columns: a time column (by name or 1-based index) or none; the data columns to keep
 //!   (by name or index) each with its [`Unit`]; unselected columns are only counted, never
 //!   parsed. Values are converted to SI while parsing, the only math a reader does.
+//! * Week + seconds of week: with [`TextOptions::week_column`] the time column counts
+//!   seconds within a week and the week column holds the week number (whole numbers
+//!   0–65 535); the log's time is `time + (week − first week) × 604 800 s`, i.e. seconds
+//!   from the start of the first row's week ([`ImuLog::week`]), increasing across a week
+//!   boundary.
 //! * τ0: the median time-stamp difference when there is a time column (a given rate must
 //!   agree within `rate_tolerance`), else `1 / rate_hz`.
+//! * Field count: every row must have the reference row's; that is the header, else the
+//!   first data row unless it is shorter than the common count of the rows after it (then
+//!   the first such row; see `io::edge`), so an error never cites a bad row as its own
+//!   reference.
+//! * Truncated edge records (only with [`TextOptions::drop_truncated_edges`]): a first or
+//!   last data record with fewer fields than the reference row, or whose cut field (first
+//!   field of the first record, last of the last) is not a number, or — for the last record
+//!   without a line end when the time column is the last field — whose time does not follow
+//!   the previous row's, is dropped and reported in [`ImuLog::notes`]. Such records are
+//!   what a logger leaves when it starts or stops mid-line. Anywhere else a bad row stays
+//!   an error. A first record that still parses whole (a cut that left a shorter but valid
+//!   number) cannot be told from a good one and is kept.
 //!
 //! Streaming: the input is read in chunks of [`TextOptions::chunk_bytes`] (16 MiB), cut at
 //! the last line end, split into one piece per rayon thread at line ends and parsed in
@@ -30,6 +47,7 @@ use std::str::FromStr;
 
 use rayon::prelude::*;
 
+use super::edge::{Cut, Edge, REFERENCE_SAMPLE, is_number, last_data_line, note, reference_count};
 use super::error::{Location, LogError, excerpt};
 use super::log::{Channel, ImuLog, TimeGap};
 use super::number::{parse_f64, parse_prefix};
@@ -129,6 +147,12 @@ pub struct TextOptions {
     pub gap_factor: f64,
     /// Bytes read per chunk (16 MiB by default; minimum 64).
     pub chunk_bytes: usize,
+    /// Week-number column (by name or index) of a time given as week + seconds of week;
+    /// needs `time_column` (the seconds of week). See the module docs.
+    pub week_column: Option<ColumnRef>,
+    /// Drop a truncated first or last data record with a note instead of failing (see
+    /// the module docs). Off by default: every row must then be whole.
+    pub drop_truncated_edges: bool,
 }
 
 impl Default for TextOptions {
@@ -146,6 +170,8 @@ impl Default for TextOptions {
             gap_policy: GapPolicy::Error,
             gap_factor: 1.5,
             chunk_bytes: 16 << 20,
+            week_column: None,
+            drop_truncated_edges: false,
         }
     }
 }
@@ -179,6 +205,16 @@ impl TextOptions {
     /// Sets the gap policy.
     pub fn with_gap_policy(mut self, policy: GapPolicy) -> Self {
         self.gap_policy = policy;
+        self
+    }
+    /// Sets the week-number column of a week + seconds-of-week time.
+    pub fn with_week_column(mut self, column: ColumnRef) -> Self {
+        self.week_column = Some(column);
+        self
+    }
+    /// Drops truncated first and last records with a note.
+    pub fn dropping_truncated_edges(mut self) -> Self {
+        self.drop_truncated_edges = true;
         self
     }
 }
@@ -400,7 +436,7 @@ struct Slot {
 struct Plan {
     delim: Delim,
     nfields: usize,
-    /// Line that fixed the field count (header or first data row).
+    /// Line that fixed the field count (header or reference data row, see `io::edge`).
     reference_line: usize,
     names: Vec<String>,
     slots: Vec<Option<Slot>>,
@@ -409,6 +445,8 @@ struct Plan {
     time_field: Option<usize>,
     channels: Vec<(usize, String, Unit)>,
     header_line: Option<usize>,
+    /// Field of the week column, whose output vector comes after the channels'.
+    week_field: Option<usize>,
 }
 
 enum FieldErr {
@@ -695,15 +733,77 @@ fn resolve(r: &ColumnRef, names: &[String], at: &Location) -> Result<usize, LogE
     }
 }
 
-/// Builds the plan from the first non-comment line (`line_no` 1-based).
+/// A non-comment line of the first chunk: 1-based number, byte range of the line with its
+/// line end in the chunk, and its text without the line end.
+struct SampleLine<'a> {
+    line: usize,
+    end: usize,
+    text: &'a [u8],
+}
+
+/// Number of fields of a line.
+fn field_count(line: &[u8], delim: Delim) -> usize {
+    for_each_field(line, delim, |_, _, _| Ok::<(), ()>(())).unwrap_or(0)
+}
+
+/// 1-based byte column where a row with `found` fields departs from `expected`: the start
+/// of the first extra field, or the end of the line.
+fn ragged_col(line: &[u8], delim: Delim, expected: usize) -> usize {
+    let mut extra = None;
+    let _ = for_each_field(line, delim, |field, start, _| {
+        if field == expected {
+            extra.get_or_insert(start);
+        }
+        Ok::<(), ()>(())
+    });
+    extra.unwrap_or(line.len()) + 1
+}
+
+/// The text of field `k` (0-based) of a line.
+fn field_text(line: &[u8], delim: Delim, k: usize) -> Option<Vec<u8>> {
+    let mut out = None;
+    let _ = for_each_field(line, delim, |field, _, t| {
+        if field == k {
+            out = Some(t.to_vec());
+        }
+        Ok::<(), ()>(())
+    });
+    out
+}
+
+/// The plan, and where the data starts: the index into the sample of the first data line
+/// to parse (`sample.len()` when the sample holds none), with the note for a dropped first
+/// record.
+type PlanStart = (Plan, usize, Option<String>);
+
+/// Builds the plan from the first non-comment lines of the input (`sample[0]` is the
+/// first; the rest vote on the reference field count and, with `Delimiter::Auto`, on the
+/// delimiter).
 fn make_plan(
-    first: &[u8],
-    line_no: usize,
+    sample: &[SampleLine<'_>],
     source: &str,
     opts: &TextOptions,
-) -> Result<Plan, LogError> {
+) -> Result<PlanStart, LogError> {
+    let Some(head) = sample.first() else {
+        return Err(LogError::Empty {
+            at: Location::input(source),
+        });
+    };
+    let (first, line_no) = (head.text, head.line);
     let delim = match opts.delimiter {
-        Delimiter::Auto => detect_delimiter(first),
+        Delimiter::Auto => {
+            // The first line's delimiter unless most sampled lines say otherwise (a cut
+            // first record may hold a single field).
+            let votes: Vec<Delim> = sample.iter().map(|l| detect_delimiter(l.text)).collect();
+            let count = |d: Delim| votes.iter().filter(|&&v| v == d).count();
+            let mut best = votes[0];
+            for &v in &votes {
+                if count(v) > count(best) {
+                    best = v;
+                }
+            }
+            best
+        }
         Delimiter::Comma => Delim::Byte(b','),
         Delimiter::Semicolon => Delim::Byte(b';'),
         Delimiter::Tab => Delim::Byte(b'\t'),
@@ -711,19 +811,36 @@ fn make_plan(
     };
     let mut fields: Vec<String> = Vec::new();
     let mut numeric = true;
-    let _ = for_each_field(first, delim, |_, _, t| {
-        if !t.is_empty() && parse_f64(t).is_none() {
-            numeric = false;
+    let mut rest_numeric = true;
+    let _ = for_each_field(first, delim, |k, _, t| {
+        let bad = !t.is_empty() && parse_f64(t).is_none();
+        numeric &= !bad;
+        if k > 0 {
+            rest_numeric &= is_number(t);
         }
         fields.push(String::from_utf8_lossy(t).into_owned());
         Ok::<(), ()>(())
     });
+    // With dropping on, a first line whose fields are numbers but for the first is a
+    // record cut inside its first number, not a header.
+    let cut_first_line =
+        opts.drop_truncated_edges && fields.len() >= 2 && rest_numeric && sample.len() >= 2;
     let has_header = match opts.header {
-        HeaderMode::Auto => !numeric,
+        HeaderMode::Auto => !numeric && !cut_first_line,
         HeaderMode::Present => true,
         HeaderMode::Absent => false,
     };
-    let nfields = fields.len();
+    let data = if has_header { &sample[1..] } else { sample };
+    let (nfields, reference_line) = if has_header {
+        (fields.len(), line_no)
+    } else {
+        let rows: Vec<(usize, usize)> = data
+            .iter()
+            .take(REFERENCE_SAMPLE + 1)
+            .map(|l| (l.line, field_count(l.text, delim)))
+            .collect();
+        reference_count(&rows).unwrap_or((fields.len(), line_no))
+    };
     let at_line = Location::line(source, line_no);
     let at_input = Location::input(source);
     let (mut names, hints): (Vec<String>, Vec<Option<String>>) = if has_header {
@@ -741,8 +858,13 @@ fn make_plan(
     }
     if let Some(given) = &opts.column_names {
         if given.len() != nfields {
+            let at = if has_header || reference_line == line_no {
+                at_line
+            } else {
+                Location::line(source, reference_line)
+            };
             return Err(LogError::InvalidOptions {
-                at: at_line,
+                at,
                 message: format!(
                     "{} column names given, but the row has {nfields} fields",
                     given.len()
@@ -791,9 +913,13 @@ fn make_plan(
             Some(f)
         }
     };
+    let week_field = match &opts.week_column {
+        Some(r) => Some(resolve(r, &names, loc)?),
+        None => None,
+    };
     let specs: Vec<ColumnSpec> = if opts.columns.is_empty() {
         (1..=nfields)
-            .filter(|&i| Some(i - 1) != time_field)
+            .filter(|&i| Some(i - 1) != time_field && Some(i - 1) != week_field)
             .map(|i| ColumnSpec {
                 column: ColumnRef::Index(i),
                 unit: None,
@@ -803,18 +929,19 @@ fn make_plan(
     } else {
         opts.columns.clone()
     };
+    let twice = |f: usize, names: &[String]| LogError::InvalidOptions {
+        at: at_input.clone(),
+        message: format!(
+            "column {} ({}) is selected twice (as time, week or data)",
+            f + 1,
+            names[f]
+        ),
+    };
     let mut channels = Vec::with_capacity(specs.len());
     for spec in &specs {
         let f = resolve(&spec.column, &names, loc)?;
-        if slots[f].is_some() {
-            return Err(LogError::InvalidOptions {
-                at: at_input,
-                message: format!(
-                    "column {} ({}) is selected twice (as time or data)",
-                    f + 1,
-                    names[f]
-                ),
-            });
+        if slots[f].is_some() || Some(f) == week_field {
+            return Err(twice(f, &names));
         }
         let unit = match &spec.unit {
             Some(u) => u.clone(),
@@ -840,17 +967,73 @@ fn make_plan(
             message: "no data columns to read (the only column is the time column)".into(),
         });
     }
-    Ok(Plan {
+    if let Some(f) = week_field {
+        if time_field.is_none() {
+            return Err(LogError::InvalidOptions {
+                at: at_input,
+                message: "a week column needs a time column (the seconds of week)".into(),
+            });
+        }
+        if slots[f].is_some() {
+            return Err(twice(f, &names));
+        }
+        slots[f] = Some(Slot {
+            out: nout,
+            scale: 1.0,
+            offset: 0.0,
+        });
+        nout += 1;
+    }
+    let plan = Plan {
         delim,
         nfields,
-        reference_line: line_no,
+        reference_line,
         names,
         slots,
         nout,
         time_field,
         channels,
         header_line: has_header.then_some(line_no),
-    })
+        week_field,
+    };
+    // The first data row: whole, dropped as a cut record, or an error citing a good row.
+    let k = usize::from(has_header);
+    let mut note_first = None;
+    let mut start = k;
+    if let Some(row) = sample.get(k) {
+        let found = field_count(row.text, delim);
+        let parsed_first = plan.slots.first().is_some_and(Option::is_some);
+        let cut = if found < nfields {
+            Some(Cut::Fields {
+                found,
+                expected: nfields,
+                reference_line,
+            })
+        } else if found == nfields
+            && parsed_first
+            && !field_text(row.text, delim, 0).is_some_and(|t| is_number(&t))
+        {
+            Some(Cut::Number { field: 1 })
+        } else {
+            None
+        };
+        match cut {
+            Some(cut) if opts.drop_truncated_edges && sample.len() > k + 1 => {
+                note_first = Some(note(source, row.line, Edge::First, &cut, row.text));
+                start = k + 1;
+            }
+            _ if found != nfields => {
+                return Err(LogError::Ragged {
+                    at: Location::field(source, row.line, ragged_col(row.text, delim, nfields)),
+                    found,
+                    expected: nfields,
+                    reference_line,
+                });
+            }
+            _ => {}
+        }
+    }
+    Ok((plan, start, note_first))
 }
 
 fn validate(opts: &TextOptions, source: &str) -> Result<(), LogError> {
@@ -919,6 +1102,9 @@ fn read_impl<R: Read>(
     let mut rows_total = 0usize;
     let mut anchors: Vec<(usize, usize)> = Vec::new();
     let mut bytes_per_row: Option<f64> = None;
+    let mut notes: Vec<String> = Vec::new();
+    // Line and text of a last record kept although it had no line end.
+    let mut unterminated_last: Option<(usize, Vec<u8>)> = None;
     loop {
         while filled < buf.len() && !eof {
             match reader.read(&mut buf[filled..]) {
@@ -945,31 +1131,57 @@ fn read_impl<R: Read>(
         let mut start = 0;
         if plan.is_none() {
             let mut offset = 0;
+            let mut sample = Vec::new();
+            let mut starts = Vec::new();
             for (i, line) in lines(region).enumerate() {
                 let this_len = line_len_with_end(region, offset);
                 if !is_blank_or_comment(line) {
-                    let p = make_plan(line, line_base + i, source, opts)?;
-                    if p.header_line.is_some() {
-                        start = offset + this_len;
-                        line_base += i + 1;
-                    } else {
-                        start = offset;
-                        line_base += i;
+                    starts.push(offset);
+                    sample.push(SampleLine {
+                        line: line_base + i,
+                        end: offset + this_len,
+                        text: line,
+                    });
+                    if sample.len() > REFERENCE_SAMPLE + 2 {
+                        break;
                     }
-                    plan = Some(p);
-                    break;
                 }
                 offset += this_len;
             }
-            if plan.is_none() {
+            if sample.is_empty() {
                 line_base += lines(region).count();
                 start = end;
+            } else {
+                let (p, first, note_first) = make_plan(&sample, source, opts)?;
+                notes.extend(note_first);
+                match (sample.get(first), first.checked_sub(1).map(|i| &sample[i])) {
+                    (Some(row), _) => {
+                        start = starts[first];
+                        line_base = row.line;
+                    }
+                    (None, Some(prev)) => {
+                        start = prev.end;
+                        line_base = prev.line + 1;
+                    }
+                    (None, None) => {}
+                }
+                plan = Some(p);
             }
         }
         if let Some(p) = &plan
             && start < end
         {
-            let data = &region[start..end];
+            // The last data record, parsed on its own when it may be dropped.
+            let (body_end, tail) = match (eof && opts.drop_truncated_edges)
+                .then(|| last_data_line(&region[start..end], |l| !is_blank_or_comment(l)))
+                .flatten()
+            {
+                Some((ls, le, terminated)) => {
+                    (start + ls, Some((start + ls, start + le, terminated)))
+                }
+                None => (end, None),
+            };
+            let data = &region[start..body_end];
             let pieces = split_pieces(data, if data.len() >= (1 << 20) { threads } else { 1 });
             let row_guess = bytes_per_row
                 .map(|b| ((data.len() as f64 / pieces.len() as f64) / b * 1.05) as usize + 16)
@@ -1026,6 +1238,59 @@ fn read_impl<R: Read>(
                     Err(e) => return Err(piece_error(e, line_base, p, source)),
                 }
             }
+            if let Some((ls, le, terminated)) = tail {
+                let text = region[ls..le]
+                    .strip_suffix(b"\r")
+                    .unwrap_or(&region[ls..le]);
+                let mut row: Vec<Vec<f64>> = (0..p.nout).map(|_| Vec::with_capacity(1)).collect();
+                match parse_line(text, p, &mut row) {
+                    Ok(_) => {
+                        if out.is_empty() {
+                            out = (0..p.nout).map(|_| Vec::new()).collect();
+                        }
+                        for (o, c) in out.iter_mut().zip(&row) {
+                            o.extend_from_slice(c);
+                        }
+                        if anchors.last().map(|&(ar, al)| al + (rows_total - ar)) != Some(line_base)
+                        {
+                            anchors.push((rows_total, line_base));
+                        }
+                        rows_total += 1;
+                        if !terminated {
+                            unterminated_last = Some((line_base, text.to_vec()));
+                        }
+                    }
+                    Err((col, kind)) => {
+                        let found = field_count(text, p.delim);
+                        let cut = match kind {
+                            FieldErr::Ragged { found } if found < p.nfields => Some(Cut::Fields {
+                                found,
+                                expected: p.nfields,
+                                reference_line: p.reference_line,
+                            }),
+                            FieldErr::NonNumeric { field, .. } | FieldErr::Empty { field }
+                                if field == found =>
+                            {
+                                Some(Cut::Number { field })
+                            }
+                            _ => None,
+                        };
+                        match cut {
+                            Some(cut) => {
+                                notes.push(note(source, line_base, Edge::Last, &cut, text))
+                            }
+                            None => {
+                                return Err(piece_error(
+                                    PieceErr { line: 0, col, kind },
+                                    line_base,
+                                    p,
+                                    source,
+                                ));
+                            }
+                        }
+                    }
+                }
+            }
         }
         if eof {
             break;
@@ -1048,10 +1313,32 @@ fn read_impl<R: Read>(
             },
         });
     }
+    // A last record without a line end whose time (its last field) does not advance was
+    // cut inside the time stamp.
+    if let (Some((line, text)), Some(tf), Some(t)) =
+        (&unterminated_last, plan.time_field, out.first())
+        && tf + 1 == plan.nfields
+        && let [.., previous_s, time_s] = t[..]
+        && time_s <= previous_s
+    {
+        let cut = Cut::Time { time_s, previous_s };
+        notes.push(note(source, *line, Edge::Last, &cut, text));
+        for c in &mut out {
+            c.pop();
+        }
+        rows_total -= 1;
+    }
     for c in &mut out {
         c.shrink_to_fit();
     }
     let map = LineMap { anchors };
+    let week = match plan.week_field {
+        Some(wf) => {
+            let weeks = out.pop().unwrap_or_default();
+            Some(combine_weeks(&mut out[0], &weeks, wf, &plan, &map, source)?)
+        }
+        None => None,
+    };
     let mut cols = out.into_iter();
     let time_s = if plan.time_field.is_some() {
         cols.next()
@@ -1087,7 +1374,40 @@ fn read_impl<R: Read>(
         channels,
         segments,
         gaps,
+        week,
+        notes,
     })
+}
+
+/// Seconds of week + week numbers → seconds from the start of the first row's week
+/// (`t += (week − week₀) × 604 800 s`); returns week₀. Weeks must be whole numbers in
+/// 0–65 535.
+fn combine_weeks(
+    t: &mut [f64],
+    weeks: &[f64],
+    wf: usize,
+    plan: &Plan,
+    map: &LineMap,
+    source: &str,
+) -> Result<u16, LogError> {
+    const WEEK_S: f64 = 604_800.0;
+    let name = plan.names.get(wf).cloned().unwrap_or_default();
+    for (i, &w) in weeks.iter().enumerate() {
+        if !(w.fract() == 0.0 && (0.0..=f64::from(u16::MAX)).contains(&w)) {
+            return Err(LogError::InvalidValue {
+                at: Location::line(source, map.line_of(i)),
+                message: format!(
+                    "week {w} in column {} ({name}) is not a whole number in 0–65535",
+                    wf + 1
+                ),
+            });
+        }
+    }
+    let w0 = weeks.first().copied().unwrap_or(0.0);
+    for (ti, &w) in t.iter_mut().zip(weeks) {
+        *ti += (w - w0) * WEEK_S;
+    }
+    Ok(w0 as u16)
 }
 
 /// Length of the line starting at `offset` including its `\n`.

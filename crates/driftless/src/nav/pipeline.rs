@@ -19,8 +19,18 @@
 //! Δv_i = f_i·(t_i − t_{i−1}). The first sample has no predecessor; its interval is the
 //! nominal one (the median time-stamp difference), so no epoch is dropped.
 //!
-//! **Time**: every IMU time stamp gets [`ImuStreamOptions::time_shift_s`] added (the drive
-//! data's authors give −0.125 s: its IMU stamps lag). The GNSS time is the reference.
+//! **Time**: IMU time stamps are in [`ImuStreamOptions::time_base`] (GPS seconds of week by
+//! default; GPS week + seconds of week, Unix time in the GPST scale or in UTC, see
+//! [`TimeBase`]) and are converted to GPS seconds of the week of the first epoch
+//! ([`ImuStream::gps_week`]); a log that crosses a week boundary keeps counting past
+//! 604 800 s, as [`GnssFixes::time_s`] does. Then every stamp gets
+//! [`ImuStreamOptions::time_shift_s`] added (the drive data's authors give −0.125 s: its IMU
+//! stamps lag). The GNSS time is the reference.
+//!
+//! **Cut records**: the tagged-CSV reader drops a truncated first or last CSV record (what a
+//! logger that starts or stops mid-line leaves) and the KF-GINS readers do the same; each
+//! drop is a note in [`ImuStream::notes`] naming file and line. A bad row anywhere else is
+//! an error.
 //!
 //! **Mounting** ([`Mounting`]): a constant rotation C_vb from IMU axes (b) to the vehicle
 //! forward-right-down frame (v), applied to Δθ and Δv (exact: a constant rotation commutes
@@ -48,9 +58,11 @@ use driftless_model::linalg::{Mat3, Vec3};
 use super::attitude::Euler;
 use super::mechanization::{ImuIncrement, increments_from_rates};
 use super::outage::{OutageError, OutageSpec, OutageWindow, TimeSpan, is_masked};
+use crate::io::edge::{Edge, was_dropped};
+pub use crate::io::nav::TimeBase;
 use crate::io::nav::{
-    GnssFixes, GnssReadOptions, ImuIncrements, TickMapping, TimeTag, map_ticks_to_gps,
-    read_kfgins_gnss, read_rtklib_pos, read_rtklib_tag_file,
+    GnssFixes, GnssReadOptions, ImuIncrements, TickMapping, TimeBaseError, TimeTag,
+    map_ticks_to_gps, read_kfgins_gnss, read_rtklib_pos, read_rtklib_tag_file,
 };
 use crate::io::{
     ColumnRef, HeaderMode, ImuLog, LogError, Quantity, TextOptions, TimeUnit, Unit, read_text_bytes,
@@ -167,6 +179,16 @@ pub enum PipelineError {
     /// An option out of range.
     #[error("invalid option: {0}")]
     Option(String),
+    /// An IMU time stamp that cannot be converted to GPS time.
+    #[error("{source_name}: IMU epoch {index}: {error}")]
+    Time {
+        /// Source of the IMU data.
+        source_name: String,
+        /// 0-based epoch index (0 when the first stamp fixes the week).
+        index: usize,
+        /// What is wrong.
+        error: TimeBaseError,
+    },
 }
 
 impl From<LogError> for PipelineError {
@@ -270,6 +292,12 @@ pub struct ImuStreamOptions {
     pub gap_factor: f64,
     /// Nominal interval, s; `None` takes the median time-stamp difference.
     pub nominal_dt_s: Option<f64>,
+    /// What the IMU time stamps count ([`TimeBase`]; GPS seconds of week by default).
+    pub time_base: TimeBase,
+    /// GPS week of stamps in a week-based time base when the data do not name it (a
+    /// `gps-sow` column of a known week); it must agree with a week the data name.
+    /// Rejected with the Unix time bases, whose stamps fix the week.
+    pub gps_week: Option<u16>,
 }
 
 impl Default for ImuStreamOptions {
@@ -280,6 +308,8 @@ impl Default for ImuStreamOptions {
             gap_policy: ImuGapPolicy::Error,
             gap_factor: 2.0,
             nominal_dt_s: None,
+            time_base: TimeBase::GpsSecondsOfWeek,
+            gps_week: None,
         }
     }
 }
@@ -301,7 +331,9 @@ pub struct ImuGap {
 pub struct ImuStream {
     /// Where the data came from (for messages).
     pub source: String,
-    /// GPS week of `time_s`, when the source names it (tagged CSV); `None` otherwise.
+    /// GPS week of `time_s` (the week of the first epoch; `time_s` passes 604 800 s after a
+    /// week boundary), when the source names it (tagged CSV, a week column, Unix time
+    /// stamps, [`ImuStreamOptions::gps_week`]); `None` otherwise.
     pub gps_week: Option<u16>,
     /// Nominal interval, s.
     pub nominal_dt_s: f64,
@@ -309,6 +341,9 @@ pub struct ImuStream {
     pub epochs: Vec<ImuIncrement>,
     /// Gaps bridged under [`ImuGapPolicy::Bridge`] (empty otherwise).
     pub gaps: Vec<ImuGap>,
+    /// What the readers dropped and why (truncated first or last records), one message
+    /// per item naming file and line, for the caller to show. Empty when nothing was.
+    pub notes: Vec<String>,
 }
 
 impl ImuStream {
@@ -455,7 +490,8 @@ fn build_stream(
     opts: &ImuStreamOptions,
     mut make: impl FnMut(usize, f64) -> (Vec3, Vec3),
 ) -> Result<ImuStream, PipelineError> {
-    let time_s: Vec<f64> = raw_time_s.iter().map(|t| t + opts.time_shift_s).collect();
+    let (gps_week, gps_time_s) = to_gps_time(source, gps_week, raw_time_s, opts)?;
+    let time_s: Vec<f64> = gps_time_s.iter().map(|t| t + opts.time_shift_s).collect();
     let (nominal, gaps) = check_times(&time_s, source, opts)?;
     let c_vb = (!opts.mounting.is_identity()).then(|| opts.mounting.c_vb());
     let mut epochs = Vec::with_capacity(time_s.len());
@@ -493,6 +529,54 @@ fn build_stream(
         nominal_dt_s: nominal,
         epochs,
         gaps,
+        notes: Vec::new(),
+    })
+}
+
+/// Stamps in `opts.time_base` → (GPS week of the first, seconds from that week's start),
+/// see [`TimeBase::to_gps_week_seconds`]. `data_week` is the week the data name (tag file,
+/// week column); it and `opts.gps_week` must agree, and neither may be given with a Unix
+/// time base.
+fn to_gps_time(
+    source: &str,
+    data_week: Option<u16>,
+    time_s: &[f64],
+    opts: &ImuStreamOptions,
+) -> Result<(Option<u16>, Vec<f64>), PipelineError> {
+    let base = opts.time_base;
+    let week = match (data_week, opts.gps_week) {
+        (Some(a), Some(b)) if a != b => {
+            return Err(PipelineError::Option(format!(
+                "{source}: GPS week {b} given, but the data name week {a}"
+            )));
+        }
+        (a, b) => a.or(b),
+    };
+    if base.is_absolute() && week.is_some() {
+        return Err(PipelineError::Option(format!(
+            "{source}: time base {base} stamps name their own GPS week; do not give a week (column) with it"
+        )));
+    }
+    if base == TimeBase::GpsWeekAndSeconds && week.is_none() {
+        return Err(PipelineError::Option(format!(
+            "{source}: time base {base} needs the GPS week column of the IMU log (the text reader's week column)"
+        )));
+    }
+    base.to_gps_week_seconds(time_s, week).map_err(|error| {
+        let bad = |e: &TimeBaseError| match e {
+            TimeBaseError::BeforeGpsEpoch { value_s, .. }
+            | TimeBaseError::NonFinite { value_s, .. }
+            | TimeBaseError::PastLastWeek { value_s, .. } => *value_s,
+        };
+        let v = bad(&error);
+        PipelineError::Time {
+            source_name: source.to_owned(),
+            index: time_s
+                .iter()
+                .position(|t| t.to_bits() == v.to_bits())
+                .unwrap_or(0),
+            error,
+        }
     })
 }
 
@@ -503,6 +587,7 @@ pub fn increment_columns(incs: &[ImuIncrement]) -> ImuIncrements {
         time_s: incs.iter().map(|i| i.time_s).collect(),
         dtheta_rad: incs.iter().map(|i| i.dtheta_rad).collect(),
         dvel_m_s: incs.iter().map(|i| i.dvel_m_s).collect(),
+        notes: Vec::new(),
     }
 }
 
@@ -524,9 +609,11 @@ pub fn imu_from_kfgins(
             ),
         });
     }
-    build_stream(source, None, &inc.time_s, opts, |i, _dt| {
+    let mut s = build_stream(source, None, &inc.time_s, opts, |i, _dt| {
         (inc.dtheta_rad[i], inc.dvel_m_s[i])
-    })
+    })?;
+    s.notes.clone_from(&inc.notes);
+    Ok(s)
 }
 
 /// Which channels of an [`ImuLog`] hold the gyro and accelerometer axes x, y, z.
@@ -597,8 +684,10 @@ fn pick_channels<'a>(log: &'a ImuLog, which: &RateChannels) -> Result<RateColumn
 
 /// Stream from an [`ImuLog`] of rates (angular rate rad/s, specific force m/s², converted
 /// by the reader from the file's units): Δθ = ω·Δt, Δv = f·Δt with Δt from successive time
-/// stamps (see the module docs). The log's time stamps are taken as GPS time (after
-/// `opts.time_shift_s`).
+/// stamps (see the module docs). The log's time stamps are in `opts.time_base`, converted to
+/// GPS time, then shifted by `opts.time_shift_s`; a log read with a week column
+/// ([`crate::io::TextOptions::week_column`], base [`TimeBase::GpsWeekAndSeconds`]) names the
+/// week in [`ImuLog::week`]. The log's notes are carried into [`ImuStream::notes`].
 pub fn imu_from_rates_log(
     log: &ImuLog,
     channels: &RateChannels,
@@ -622,12 +711,15 @@ pub fn imu_from_rates_log(
             message: format!("channel lengths differ from the {n} time stamps"),
         });
     }
-    rates_to_stream(source, None, time_s, gyro, accel, opts)
+    let mut s = rates_to_stream(source, log.week, time_s, gyro, accel, opts)?;
+    s.notes.clone_from(&log.notes);
+    Ok(s)
 }
 
 /// Stream from rate columns (angular rate rad/s, specific force m/s²) at time stamps
-/// `time_s` (GPS s): Δθ = ω·Δt, Δv = f·Δt with Δt from successive stamps, as
-/// [`imu_from_rates_log`] does for a log.
+/// `time_s` in `opts.time_base` (GPS seconds of week `gps_week` by default): Δθ = ω·Δt,
+/// Δv = f·Δt with Δt from successive stamps, as [`imu_from_rates_log`] does for a log.
+/// `gps_week` is the week the week-based stamps count from, when the data name it.
 pub fn rates_to_stream(
     source: &str,
     gps_week: Option<u16>,
@@ -662,18 +754,35 @@ pub const TAGGED_CSV_COLUMNS: [&str; 7] =
 /// `.tag` file. Units are converted by the text reader (g → m/s² with standard gravity
 /// 9.806 65, deg/s → rad/s); duplicate or decreasing ticks are reported there with file and
 /// line. Times: ticks → GPS s of week of the tag's week ([`map_ticks_to_gps`]), then
-/// `opts.stream.time_shift_s`.
+/// `opts.stream.time_shift_s`; `opts.stream.time_base` must be the default
+/// ([`TimeBase::GpsSecondsOfWeek`]): the `.tag` file fixes the time.
+///
+/// A truncated first or last CSV record (the logger starts and stops mid-line) is dropped
+/// and reported in [`ImuStream::notes`] (see [`crate::io::TextOptions::drop_truncated_edges`]);
+/// a bad row anywhere else is an error naming file, line and column. The tick mapping keeps
+/// the anchors the whole records would have given: a cut first record keeps its line end,
+/// so its tick (the last field) is intact and still maps to the tag's start; a cut last
+/// record's tick is lost and is taken as the last kept tick plus the median tick interval
+/// (with [`TickMapping::Stretch`] this end anchor then errs by the tick jitter, ±1 ms on
+/// the drive data, instead of one whole sample interval).
 pub fn imu_from_tagged_csv(
     csv: &[u8],
     csv_name: &str,
     tag: &TimeTag,
     opts: &TaggedCsvOptions,
 ) -> Result<ImuStream, PipelineError> {
+    if opts.stream.time_base != TimeBase::GpsSecondsOfWeek {
+        return Err(PipelineError::Option(format!(
+            "{csv_name}: the tagged CSV's time comes from its .tag file (GPS time); time base {} does not apply",
+            opts.stream.time_base
+        )));
+    }
     let mut text = TextOptions {
         header: HeaderMode::Auto,
         // The ticks jitter by ±1 ms around 10 ms; gaps are judged later on GPS time
         // with the pipeline's own policy, so the reader only lists them.
         gap_policy: crate::io::GapPolicy::Bridge,
+        drop_truncated_edges: true,
         ..TextOptions::default()
     }
     .with_names(TAGGED_CSV_COLUMNS)
@@ -692,17 +801,66 @@ pub fn imu_from_tagged_csv(
             source_name: csv_name.to_owned(),
         });
     };
-    let ticks_ms: Vec<f64> = t_s.iter().map(|t| t * 1e3).collect();
-    let gps = map_ticks_to_gps(tag, &ticks_ms, opts.tick_mapping, csv_name, 1)?;
+    let mut ticks_ms: Vec<f64> = t_s.iter().map(|t| t * 1e3).collect();
+    let n = ticks_ms.len();
+    // Anchors of dropped edge records (see the doc comment).
+    let first_tick = cut_first_tick(csv).filter(|&t| {
+        was_dropped(&log.notes, Edge::First) && ticks_ms.first().is_some_and(|&f| t < f)
+    });
+    let last_tick = match ticks_ms.as_slice() {
+        &[_, .., b] if was_dropped(&log.notes, Edge::Last) => {
+            let mut d: Vec<f64> = ticks_ms.windows(2).map(|w| w[1] - w[0]).collect();
+            let mid = d.len() / 2;
+            let step = *d.select_nth_unstable_by(mid, f64::total_cmp).1;
+            Some(b + step)
+        }
+        _ => None,
+    };
+    if let Some(t) = first_tick {
+        ticks_ms.insert(0, t);
+    }
+    if let Some(t) = last_tick {
+        ticks_ms.push(t);
+    }
+    let mut gps = map_ticks_to_gps(tag, &ticks_ms, opts.tick_mapping, csv_name, 1)?;
+    let skip = usize::from(first_tick.is_some());
+    gps.time_s = gps.time_s[skip..skip + n].to_vec();
     let ch = |k: usize| log.channels[k].values.as_slice();
-    rates_to_stream(
+    let mut s = rates_to_stream(
         csv_name,
         Some(gps.gps_week),
         &gps.time_s,
         [ch(3), ch(4), ch(5)],
         [ch(0), ch(1), ch(2)],
         &opts.stream,
-    )
+    )?;
+    s.notes = log.notes;
+    Ok(s)
+}
+
+/// The tick (last field, ms) of the first data line of a tagged CSV (the first line whose
+/// last field is a number, so a header is passed over), when that line is not a whole
+/// record (fewer than 7 fields, or a first field that is not a number): the line end of a
+/// record cut at its start, with its tick, is intact.
+fn cut_first_tick(csv: &[u8]) -> Option<f64> {
+    let last_is_number = |l: &[u8]| {
+        std::str::from_utf8(l)
+            .ok()
+            .and_then(|t| t.rsplit(',').next())
+            .is_some_and(|f| f.trim().parse::<f64>().is_ok())
+    };
+    let line = csv
+        .split(|&b| b == b'\n')
+        .map(|l| l.trim_ascii())
+        .find(|l| !l.is_empty() && !l.starts_with(b"#") && last_is_number(l))?;
+    let text = std::str::from_utf8(line).ok()?;
+    let fields: Vec<&str> = text.split(',').map(str::trim).collect();
+    let whole = fields.len() >= TAGGED_CSV_COLUMNS.len()
+        && fields.first().is_some_and(|f| f.parse::<f64>().is_ok());
+    if whole {
+        return None;
+    }
+    fields.last()?.parse::<f64>().ok().filter(|t| t.is_finite())
 }
 
 /// [`imu_from_tagged_csv`] from files; the `.tag` record layout is detected
@@ -793,6 +951,7 @@ pub fn subset_fixes(g: &GnssFixes, keep: &[bool]) -> GnssFixes {
         sigma_vel_ned_m_s: g.sigma_vel_ned_m_s.as_deref().map(|v| pick(v, keep)),
         quality: pick(&g.quality, keep),
         n_sats: g.n_sats.as_deref().map(|v| pick(v, keep)),
+        notes: g.notes.clone(),
     }
 }
 

@@ -5,9 +5,12 @@
 //! **Input files.** One epoch per line; fields separated by any run of spaces, tabs or
 //! commas (KF-GINS splits on `", \t"` and skips empty pieces). No header, no comments.
 //! KF-GINS feeds every field to `strtod` without checks; here every field must be a finite
-//! number, every row must have as many fields as the first, and time must strictly
-//! increase — otherwise one [`LogError`] names the file, line and column. Blank lines are
-//! skipped (KF-GINS stops reading at the first blank line).
+//! number, every row must have as many fields as the reference row (the first, unless it is
+//! shorter than the rows after it; see `io::edge`), and time must strictly increase —
+//! otherwise one [`LogError`] names the file, line and column. Blank lines are skipped
+//! (KF-GINS stops reading at the first blank line). A truncated first or last record (fewer
+//! fields than the reference row, or a cut field that is not a number: what a logger that
+//! starts or stops mid-line leaves) is dropped and reported in the result's `notes`.
 //!
 //! * IMU (`imupath`): `time [GPS s of week], dθx, dθy, dθz [rad], dvx, dvy, dvz [m/s]`,
 //!   increments over the interval ending at `time`, body frame forward-right-down. KF-GINS
@@ -35,6 +38,9 @@ use std::path::{Path, PathBuf};
 use super::types::{GnssFixes, ImuErrors, ImuIncrements, NavSolution, NavStd, common_len};
 use super::{
     Field, as_utf8, check_time_order, parse_num, read_file, split_fields, split_fields_into,
+};
+use crate::io::edge::{
+    Edge, REFERENCE_SAMPLE, cut_record, last_data_line, line_of_offset, note, reference_count,
 };
 use crate::io::{Location, LogError};
 
@@ -145,6 +151,107 @@ fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
         .filter(|(_, l)| !l.trim().is_empty())
 }
 
+/// The rows of a KF-GINS input to parse, after the edge checks.
+struct Body {
+    /// Field count of every row.
+    expected: usize,
+    /// Its reference line.
+    ref_line: usize,
+    /// Byte range of the rows to parse and the 1-based line of its start.
+    start: usize,
+    end: usize,
+    first_line: usize,
+    /// Notes on dropped edge records.
+    notes: Vec<String>,
+}
+
+/// Fixes the reference field count (`io::edge`) and drops a truncated first or last
+/// record. `valid` checks the reference count (`Err(message)` names what the format
+/// needs). A first row with another count that is not a cut record is an error citing
+/// the reference row.
+fn edge_body(
+    text: &str,
+    name: &str,
+    format: &'static str,
+    valid: impl Fn(usize) -> Result<(), String>,
+) -> Result<Body, LogError> {
+    let sample: Vec<(usize, &str)> = data_lines(text).take(REFERENCE_SAMPLE + 1).collect();
+    let counts: Vec<(usize, usize)> = sample
+        .iter()
+        .map(|&(l, t)| (l, split_fields(t, SEPS).len()))
+        .collect();
+    let Some((expected, ref_line)) = reference_count(&counts) else {
+        return Err(LogError::Empty {
+            at: Location::input(name),
+        });
+    };
+    if let Err(message) = valid(expected) {
+        let len = sample
+            .iter()
+            .find(|s| s.0 == ref_line)
+            .map_or(0, |s| s.1.len());
+        return Err(LogError::Malformed {
+            at: Location::field(name, ref_line, len + 1),
+            format,
+            message,
+        });
+    }
+    let texts = |l: &str| -> Vec<Vec<u8>> {
+        split_fields(l, SEPS)
+            .iter()
+            .map(|f| f.text.as_bytes().to_vec())
+            .collect()
+    };
+    let mut body = Body {
+        expected,
+        ref_line,
+        start: 0,
+        end: text.len(),
+        first_line: 1,
+        notes: Vec::new(),
+    };
+    let (l0, t0) = sample[0];
+    let f0 = texts(t0);
+    let f0: Vec<&[u8]> = f0.iter().map(Vec::as_slice).collect();
+    match cut_record(&f0, expected, ref_line, Edge::First) {
+        Some(cut) if sample.len() > 1 => {
+            body.notes
+                .push(note(name, l0, Edge::First, &cut, t0.as_bytes()));
+            // Start at the line after the dropped one.
+            let off = t0.as_ptr() as usize - text.as_ptr() as usize + t0.len();
+            body.start = text[off..].find('\n').map_or(text.len(), |p| off + p + 1);
+            body.first_line = l0 + 1;
+        }
+        _ if f0.len() != expected => {
+            let fields = split_fields(t0, SEPS);
+            let col = fields.get(expected).map_or(t0.len() + 1, |f| f.col);
+            return Err(LogError::Ragged {
+                at: Location::field(name, l0, col),
+                found: fields.len(),
+                expected,
+                reference_line: ref_line,
+            });
+        }
+        _ => {}
+    }
+    let bytes = text.as_bytes();
+    if let Some((ls, le, _)) = last_data_line(bytes, |l| !l.trim_ascii().is_empty())
+        && ls >= body.start
+        && !text[body.start..ls].trim().is_empty()
+    {
+        let l = text[ls..le].strip_suffix('\r').unwrap_or(&text[ls..le]);
+        let f = texts(l);
+        let f: Vec<&[u8]> = f.iter().map(Vec::as_slice).collect();
+        if let Some(cut) = cut_record(&f, expected, ref_line, Edge::Last) {
+            let line = line_of_offset(bytes, ls);
+            body.notes
+                .push(note(name, line, Edge::Last, &cut, l.as_bytes()));
+            body.end = ls;
+        }
+    }
+    Ok(body)
+}
+
 /// Checks the field count of a row against the first row's.
 fn check_count(
     fields: &[Field<'_>],
@@ -196,22 +303,21 @@ fn read_imu_in_blocks(
 ) -> Result<ImuIncrements, LogError> {
     use rayon::prelude::*;
     let text = as_utf8(bytes, name)?;
-    // The first data row fixes the column count of all rows.
-    let Some((ref_line, first)) = data_lines(text).next() else {
-        return Err(LogError::Empty {
-            at: Location::input(name),
-        });
-    };
-    let expected = split_fields(first, SEPS).len();
-    if expected < 7 {
-        return Err(LogError::Ragged {
-            at: Location::field(name, ref_line, first.len() + 1),
-            found: expected,
-            expected: 7,
-            reference_line: ref_line,
-        });
-    }
-    let blocks = line_blocks(text, block_bytes.max(1));
+    let body = edge_body(text, name, "KF-GINS IMU", |n| {
+        if n < 7 {
+            Err(format!(
+                "rows have {n} fields; the format needs at least 7 (time, Δθ x y z, Δv x y z)"
+            ))
+        } else {
+            Ok(())
+        }
+    })?;
+    let (expected, ref_line) = (body.expected, body.ref_line);
+    let blocks = line_blocks(
+        &text[body.start..body.end],
+        block_bytes.max(1),
+        body.first_line,
+    );
     let parts: Vec<ImuBlock> = blocks
         .par_iter()
         .map(|&(line0, block)| parse_imu_block(block, line0, expected, ref_line, name))
@@ -221,6 +327,7 @@ fn read_imu_in_blocks(
         time_s: Vec::with_capacity(n),
         dtheta_rad: Vec::with_capacity(n),
         dvel_m_s: Vec::with_capacity(n),
+        notes: body.notes,
     };
     for part in parts {
         // Time order across the block boundary, at the block's first data line.
@@ -241,8 +348,8 @@ fn read_imu_in_blocks(
 const IMU_BLOCK_BYTES: usize = 1 << 22;
 
 /// Splits `text` after newlines into blocks of about `target` bytes, each with the
-/// 1-based number of its first line.
-fn line_blocks(text: &str, target: usize) -> Vec<(usize, &str)> {
+/// 1-based number of its first line (`text` starts at line `first_line`).
+fn line_blocks(text: &str, target: usize, first_line: usize) -> Vec<(usize, &str)> {
     use rayon::prelude::*;
     let bytes = text.as_bytes();
     let mut cuts = vec![0];
@@ -264,7 +371,7 @@ fn line_blocks(text: &str, target: usize) -> Vec<(usize, &str)> {
         .par_iter()
         .map(|p| p.bytes().filter(|&b| b == b'\n').count())
         .collect();
-    let mut line0 = 1;
+    let mut line0 = first_line;
     pieces
         .into_iter()
         .zip(newlines)
@@ -383,23 +490,26 @@ pub fn read_kfgins_gnss(
     opts: &GnssReadOptions,
 ) -> Result<GnssFixes, LogError> {
     let text = as_utf8(bytes, name)?;
-    let mut out = GnssFixes::default();
+    let body = edge_body(text, name, "KF-GINS GNSS", |n| {
+        if n == 7 || n == 13 {
+            Ok(())
+        } else {
+            Err(format!(
+                "rows have {n} fields; the format has 7 (time, lat, lon, h, σ N E D) or 13 (with velocity and its σ)"
+            ))
+        }
+    })?;
+    let (expected, ref_line) = (body.expected, body.ref_line);
+    let mut out = GnssFixes {
+        notes: body.notes,
+        ..GnssFixes::default()
+    };
     let mut vel = Vec::new();
     let mut svel = Vec::new();
-    let mut reference: Option<(usize, usize)> = None;
     let mut prev: Option<f64> = None;
-    for (line, l) in data_lines(text) {
+    for (line, l) in data_lines(&text[body.start..body.end]) {
+        let line = line + body.first_line - 1;
         let fields = split_fields(l, SEPS);
-        let (expected, ref_line) = *reference.get_or_insert((fields.len(), line));
-        if expected != 7 && expected != 13 {
-            let col = fields.get(7).map_or(l.len() + 1, |f| f.col);
-            return Err(LogError::Ragged {
-                at: Location::field(name, line, col),
-                found: fields.len(),
-                expected: if expected < 7 { 7 } else { 13 },
-                reference_line: line,
-            });
-        }
         check_count(&fields, l, expected, ref_line, name, line)?;
         let names: &[&str] = if expected == 7 {
             &GNSS_NAMES_7
@@ -452,7 +562,7 @@ pub fn read_kfgins_gnss(
             at: Location::input(name),
         });
     }
-    if reference.is_some_and(|(n, _)| n == 13) {
+    if expected == 13 {
         out.vel_ned_m_s = Some(vel);
         out.sigma_vel_ned_m_s = Some(svel);
     }
@@ -729,6 +839,7 @@ mod input_writer_tests {
             time_s: vec![100.005, 100.010],
             dtheta_rad: vec![[1.234_567_890_123e-5, -2e-6, 3e-7], [4e-5, 5e-5, -6e-5]],
             dvel_m_s: vec![[0.049_031, 1e-4, -2e-4], [0.05, 0.0, 0.001]],
+            notes: Vec::new(),
         };
         let mut buf = Vec::new();
         write_kfgins_imu(&mut buf, "imu.txt", &imu).unwrap();
@@ -1036,7 +1147,7 @@ mod tests {
     fn imu_eight_columns_ok_but_ragged_rejected() {
         let ok = "1 0 0 0 0 0 0 5.0\n2 0 0 0 0 0 0 5.1\n";
         assert_eq!(read_kfgins_imu(ok.as_bytes(), "i").unwrap().len(), 2);
-        let extra = "1 0 0 0 0 0 0\n2 0 0 0 0 0 0 9\n";
+        let extra = "1 0 0 0 0 0 0\n2 0 0 0 0 0 0 9\n3 0 0 0 0 0 0\n";
         let e = read_kfgins_imu(extra.as_bytes(), "i").unwrap_err();
         assert!(
             matches!(
@@ -1053,19 +1164,84 @@ mod tests {
             e.to_string(),
             "i:2:15: row has 8 fields, expected 7 (as on line 1)"
         );
-        let missing = "1 0 0 0 0 0 0\n2 0 0 0 0 0\n";
+        let missing = "1 0 0 0 0 0 0\n2 0 0 0 0 0\n3 0 0 0 0 0 0\n";
         let e = read_kfgins_imu(missing.as_bytes(), "i").unwrap_err();
         assert!(matches!(e, LogError::Ragged { found: 6, .. }), "{e}");
         assert_eq!(e.line(), Some(2));
-        let short = "1 0 0 0 0 0\n";
-        assert!(matches!(
-            read_kfgins_imu(short.as_bytes(), "i").unwrap_err(),
-            LogError::Ragged {
-                found: 6,
-                expected: 7,
-                ..
-            }
-        ));
+        // Too few columns for the format: the message names what it needs, not a line as
+        // its own reference.
+        let short = "1 0 0 0 0 0\n2 0 0 0 0 0\n";
+        let e = read_kfgins_imu(short.as_bytes(), "i").unwrap_err();
+        assert!(matches!(e, LogError::Malformed { .. }), "{e}");
+        assert_eq!(
+            e.to_string(),
+            "i:1:12: malformed KF-GINS IMU: rows have 6 fields; the format needs at least 7 (time, Δθ x y z, Δv x y z)"
+        );
+    }
+
+    #[test]
+    fn imu_cut_edge_records_dropped_with_notes() {
+        let whole: Vec<String> = (0..6)
+            .map(|i| format!("{}.005 1e-5 -2e-5 3e-5 0.001 0.002 -0.0981", 100 + i))
+            .collect();
+        let clean = read_kfgins_imu(whole.join("\n").as_bytes(), "i").unwrap();
+        assert!(clean.notes.is_empty());
+        // Cut at the start (inside the time) and at the end (inside the last field).
+        let mut cut = whole.clone();
+        cut[0] = "5e-5 3e-5 0.001 0.002 -0.0981".into();
+        cut[5] = "105.005 1e-5 -2e-5 3e-5 0.001 0.0".into();
+        for block in [1 << 20, 40] {
+            let r = read_imu_in_blocks(cut.join("\n").as_bytes(), "i", block).unwrap();
+            assert_eq!(r.time_s, clean.time_s[1..5].to_vec());
+            assert_eq!(r.dvel_m_s, clean.dvel_m_s[1..5].to_vec());
+            assert_eq!(r.notes.len(), 2, "{:?}", r.notes);
+            assert!(
+                r.notes[0].starts_with("i:1: dropped the first record \"5e-5")
+                    && r.notes[0].ends_with("it has 5 fields, line 2 has 7"),
+                "{}",
+                r.notes[0]
+            );
+            assert!(
+                r.notes[1].starts_with("i:6: dropped the last record")
+                    && r.notes[1].ends_with("it has 6 fields, line 2 has 7"),
+                "{}",
+                r.notes[1]
+            );
+        }
+        // A last field cut to a non-number ("1.5e") is a cut record too.
+        let mut num = whole.clone();
+        num[5] = "105.005 1e-5 -2e-5 3e-5 0.001 0.002 -9.8e".into();
+        let r = read_kfgins_imu(num.join("\n").as_bytes(), "i").unwrap();
+        assert_eq!(r.len(), 5);
+        assert!(
+            r.notes[0].ends_with("its field 7 is not a number"),
+            "{:?}",
+            r.notes
+        );
+        // The same bad row inside the file is an error, and so is a second short row
+        // after a dropped first one, citing a good reference line.
+        let mut mid = whole.clone();
+        mid[3] = "103.005 1e-5 -2e-5".into();
+        let e = read_kfgins_imu(mid.join("\n").as_bytes(), "i").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "i:4:19: row has 3 fields, expected 7 (as on line 1)"
+        );
+        let mut two = whole.clone();
+        two[0] = "1e-5 0.002 -0.0981".into();
+        two[1] = "0.002 -0.0981".into();
+        let e = read_kfgins_imu(two.join("\n").as_bytes(), "i").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "i:2:14: row has 2 fields, expected 7 (as on line 3)"
+        );
+        // A first row with more fields than the next ones is no cut record: an error at
+        // line 2 citing line 1, as before.
+        let mut long = whole;
+        long[0].push_str(" 5.0");
+        let e = read_kfgins_imu(long.join("\n").as_bytes(), "i").unwrap_err();
+        assert!(e.to_string().starts_with("i:2:"), "{e}");
+        assert!(e.to_string().ends_with("(as on line 1)"), "{e}");
     }
 
     #[test]
@@ -1130,9 +1306,10 @@ mod tests {
         // 8 columns: neither format.
         let e = read_kfgins_gnss(b"1 30 114 20 1 1 1 1\n", "g", &GnssReadOptions::default())
             .unwrap_err();
-        assert!(matches!(e, LogError::Ragged { found: 8, .. }), "{e}");
+        assert!(matches!(e, LogError::Malformed { .. }), "{e}");
+        assert!(e.to_string().contains("rows have 8 fields"), "{e}");
         // A missing column on line 2.
-        let t = "1 30 114 20 1 1 1\n2 30 114 20 1 1\n";
+        let t = "1 30 114 20 1 1 1\n2 30 114 20 1 1\n3 30 114 20 1 1 1\n";
         let e = read_kfgins_gnss(t.as_bytes(), "g", &GnssReadOptions::default()).unwrap_err();
         assert!(
             matches!(
@@ -1144,6 +1321,32 @@ mod tests {
                 }
             ),
             "{e}"
+        );
+    }
+
+    #[test]
+    fn gnss_cut_edges() {
+        let opts = GnssReadOptions::default();
+        let rows = [
+            "114.4718661162 21.095 0.010 0.009 0.019",
+            "456251.000 30.44478 114.47186 21.091 0.011 0.008 0.020",
+            "456252.000 30.44478 114.47186 21.091 0.011 0.008 0.020",
+            "456253.000 30.44478 114.4",
+        ];
+        let g = read_kfgins_gnss(rows.join("\n").as_bytes(), "g.txt", &opts).unwrap();
+        assert_eq!(g.time_s, vec![456_251.0, 456_252.0]);
+        assert_eq!(g.notes.len(), 2);
+        assert!(g.notes[0].starts_with("g.txt:1: dropped the first record"));
+        assert!(g.notes[1].starts_with("g.txt:4: dropped the last record"));
+        // A short first row of a file whose other rows are 13 wide: reference is line 2.
+        let t = "1 30 114 20 1 1 1\n2 30 114 20 1 1 1 0.1 0.1 0.1 0.1 0.1 0.1\n3 30 114 20 1 1 1 0.1 0.1 0.1 0.1 0.1 0.1\n";
+        let g = read_kfgins_gnss(t.as_bytes(), "g", &opts).unwrap();
+        assert_eq!(g.len(), 2);
+        assert!(g.vel_ned_m_s.is_some());
+        assert!(
+            g.notes[0].ends_with("it has 7 fields, line 2 has 13"),
+            "{:?}",
+            g.notes
         );
     }
 

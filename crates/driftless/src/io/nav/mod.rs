@@ -3,7 +3,8 @@
 //! Readers turn files into the typed, columnar records of [`types`] (SI units, names with
 //! units), converting units at this edge only; writers do the reverse. Every bad input gives
 //! one [`LogError`] naming the file, line and column; readers never return NaN and never
-//! return partial data.
+//! return partial data, except that a truncated first or last record (what a logger that
+//! starts or stops mid-line leaves) is dropped and reported in the result's `notes`.
 //!
 //! * [`kfgins`]: the text formats of KF-GINS (i2Nav-WHU/KF-GINS, GPL-3.0; formats learnt from
 //!   its README, `src/fileio/*` and `src/kf_gins.cpp`, no code taken): IMU increments,
@@ -23,7 +24,9 @@ pub mod rtklib;
 pub mod track;
 pub mod types;
 
-pub use gpstime::GpsTime;
+pub use gpstime::{
+    GpsTime, LEAP_SECONDS, ParseTimeBaseError, TimeBase, TimeBaseError, gps_minus_utc_s,
+};
 pub use kfgins::{
     GnssReadOptions, KfGinsOutputWriter, ZeroSigma, read_kfgins_gnss, read_kfgins_gnss_file,
     read_kfgins_imu, read_kfgins_imu_file, write_kfgins_gnss, write_kfgins_imu,

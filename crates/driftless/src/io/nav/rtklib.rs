@@ -12,7 +12,10 @@
 //! deg-min-sec layouts are refused). Units at the edge: degrees → rad; RTKLIB's
 //! north/east/**up** velocity becomes NED (`vD = −vu`); σ_D is `sdu` and σ_vD is `sdvu`
 //! (a σ does not change sign). Cross-covariances (`sdne`…), `age` and `ratio` are checked
-//! to be numbers and not kept.
+//! to be numbers and not kept. A truncated first or last epoch line (fewer fields than the
+//! column header names, or — last line — a last field that is not a number: a solution
+//! logger stopped mid-line) is dropped and reported in [`GnssFixes::notes`]; anywhere else
+//! such a line is an error.
 //!
 //! **`.tag`** (RTKLIB stream time tags, written by `stream.c` when a file stream has the
 //! `::T` option; layout learnt from RTKLIB/demo5 `stream.c`, no code taken), little-endian:
@@ -34,6 +37,7 @@ use super::gpstime::{Calendar, GpsTime};
 use super::kfgins::{GnssReadOptions, check_lat_lon, check_sigma};
 use super::types::GnssFixes;
 use super::{Field, as_utf8, check_time_order, parse_num, read_file, split_fields};
+use crate::io::edge::{Cut, Edge, cut_record, last_data_line, line_of_offset, note};
 use crate::io::{Location, LogError};
 
 const FORMAT_POS: &str = "RTKLIB .pos";
@@ -214,6 +218,18 @@ pub fn read_rtklib_pos(
     let mut prev: Option<f64> = None;
     let mut week0: Option<u16> = None;
     let mut header_line = 0;
+    // The first and last epoch lines (1-based), which may be cut records.
+    let is_epoch = |l: &[u8]| {
+        let t = l.trim_ascii();
+        !t.is_empty() && !l.starts_with(b"%")
+    };
+    let first_epoch = text
+        .lines()
+        .position(|l| is_epoch(l.as_bytes()))
+        .map(|i| i + 1);
+    let last_epoch = last_data_line(text.as_bytes(), is_epoch)
+        .map(|(ls, _, _)| line_of_offset(text.as_bytes(), ls))
+        .filter(|&l| Some(l) != first_epoch);
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let l = raw.strip_suffix('\r').unwrap_or(raw);
@@ -250,6 +266,23 @@ pub fn read_rtklib_pos(
         };
         let fields = split_fields(l, b" \t,");
         let expected = c.names.len() + 2;
+        let edge = if Some(line) == first_epoch && last_epoch.is_some() {
+            Some(Edge::First)
+        } else if Some(line) == last_epoch {
+            Some(Edge::Last)
+        } else {
+            None
+        };
+        if let Some(edge) = edge {
+            let texts: Vec<&[u8]> = fields.iter().map(|f| f.text.as_bytes()).collect();
+            // A cut first epoch line shows as missing fields; its first field is a date.
+            let cut = cut_record(&texts, expected, header_line, edge)
+                .filter(|cut| edge == Edge::Last || matches!(cut, Cut::Fields { .. }));
+            if let Some(cut) = cut {
+                out.notes.push(note(name, line, edge, &cut, l.as_bytes()));
+                continue;
+            }
+        }
         if fields.len() != expected {
             let col = fields.get(expected).map_or(l.len() + 1, |f| f.col);
             return Err(LogError::Ragged {
@@ -755,6 +788,42 @@ mod tests {
     }
 
     #[test]
+    fn pos_cut_edges() {
+        let opts = GnssReadOptions::default();
+        let hdr = POS.lines().take(3).collect::<Vec<_>>().join("\n") + "\n";
+        let rows: Vec<&str> = POS.lines().skip(3).collect();
+        let mid = rows[1].replace("18.750", "19.000");
+        let last = rows[1].replace("18.750", "19.250");
+        let clean = format!("{hdr}{}\n{}\n{mid}\n{last}\n", rows[0], rows[1]);
+        let whole = read_rtklib_pos(clean.as_bytes(), "p.pos", &opts).unwrap();
+        assert_eq!(whole.len(), 4);
+        assert!(whole.notes.is_empty());
+        // The logger stopped inside the last epoch's velocity block, without a line end.
+        let cut_at = last.len() - 12;
+        let cut = format!("{hdr}{}\n{}\n{mid}\n{}", rows[0], rows[1], &last[..cut_at]);
+        let g = read_rtklib_pos(cut.as_bytes(), "p.pos", &opts).unwrap();
+        assert_eq!(g.time_s, whole.time_s[..3].to_vec());
+        assert_eq!(g.lat_rad, whole.lat_rad[..3].to_vec());
+        assert_eq!(g.notes.len(), 1);
+        assert!(
+            g.notes[0].starts_with("p.pos:7: dropped the last record")
+                && g.notes[0].contains("line 3 has 24"),
+            "{}",
+            g.notes[0]
+        );
+        // A cut first epoch line (fewer fields) is dropped too.
+        let first_cut = &rows[0][30..];
+        let t = format!("{hdr}{first_cut}\n{}\n{mid}\n", rows[1]);
+        let g = read_rtklib_pos(t.as_bytes(), "p.pos", &opts).unwrap();
+        assert_eq!(g.time_s, whole.time_s[1..3].to_vec());
+        assert!(g.notes[0].starts_with("p.pos:4: dropped the first record"));
+        // The same short row in the middle stays an error.
+        let t = format!("{hdr}{}\n{}\n{mid}\n", rows[0], &rows[1][..cut_at]);
+        let e = read_rtklib_pos(t.as_bytes(), "p.pos", &opts).unwrap_err();
+        assert!(e.to_string().starts_with("p.pos:5:"), "{e}");
+    }
+
+    #[test]
     fn pos_errors() {
         let opts = GnssReadOptions::default();
         let hdr = POS.lines().take(3).collect::<Vec<_>>().join("\n") + "\n";
@@ -994,6 +1063,7 @@ mod tests {
             sigma_vel_ned_m_s: Some(vec![[0.02, 0.02, 0.04]; 3]),
             quality: vec![1, 2, 1],
             n_sats: Some(vec![12, 11, 12]),
+            notes: Vec::new(),
         };
         let mut buf = Vec::new();
         write_rtklib_pos(&mut buf, "x.pos", &g, "test").unwrap();

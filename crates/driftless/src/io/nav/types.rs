@@ -31,6 +31,9 @@ pub struct ImuIncrements {
     pub dtheta_rad: Vec<[f64; 3]>,
     /// Velocity increments along body x, y, z, m/s.
     pub dvel_m_s: Vec<[f64; 3]>,
+    /// What the reader dropped and why (a truncated first or last record), one message
+    /// per item naming file and line. Empty when nothing was dropped.
+    pub notes: Vec<String>,
 }
 
 impl ImuIncrements {
@@ -71,6 +74,9 @@ pub struct GnssFixes {
     pub quality: Vec<u8>,
     /// Number of satellites used, when the input has it.
     pub n_sats: Option<Vec<u8>>,
+    /// What the reader dropped and why (a truncated first or last record), one message
+    /// per item naming file and line. Empty when nothing was dropped.
+    pub notes: Vec<String>,
 }
 
 impl GnssFixes {
