@@ -321,10 +321,19 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
             )?
         }
         ImuFormat::Csv => {
-            let log = crate::io::read_log_file(&imu_path, csv)?;
+            let mut text = csv.clone();
+            text.drop_truncated_edges = true;
+            if let Some(w) = &c.imu.week_column {
+                text.week_column =
+                    Some(w.parse().map_err(|e: crate::io::text::ParseSpecError| {
+                        located(cfg, "imu.week_column", e.to_string())
+                    })?);
+            }
+            let log = crate::io::read_log_file(&imu_path, &text)?;
             imu_from_rates_log(&log, &RateChannels::ByQuantity, &opts)?
         }
     };
+    notes.extend(imu.notes.iter().cloned());
     for g in imu.gaps.iter().take(20) {
         notes.push(format!(
             "{}: IMU gap of {:.4} s before t = {:.4} s: integrated across",
@@ -348,6 +357,7 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
         imu.apply_calibration(cal);
     }
     let gnss = read_gnss_file(&gnss_path, &GnssReadOptions::default())?;
+    notes.extend(gnss.notes.iter().cloned());
     let all = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)?;
     let accepted = c.accepted_qualities();
     let keep: Vec<bool> = all

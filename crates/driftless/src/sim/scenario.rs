@@ -733,6 +733,7 @@ impl Simulation {
             nominal_dt_s: self.imu.dt_s,
             epochs: self.imu.to_increments(),
             gaps: Vec::new(),
+            notes: Vec::new(),
         }
     }
 

@@ -59,6 +59,10 @@ pub struct ImuSection {
     pub tag: Option<PathBuf>,
     /// Added to the IMU time stamps, s.
     pub time_offset_s: f64,
+    /// Time base of the IMU time column ([`crate::io::nav::TimeBase`] name).
+    pub time_base: String,
+    /// Week column of a rates CSV.
+    pub week_column: Option<String>,
     /// Nominal rate, Hz; `None` = from the time stamps.
     pub rate_hz: Option<f64>,
     /// Mounting roll, pitch, yaw, deg ([`Mounting`]).
@@ -78,6 +82,8 @@ impl Default for ImuSection {
             format: "auto".into(),
             tag: None,
             time_offset_s: 0.0,
+            time_base: "gps-sow".into(),
+            week_column: None,
             rate_hz: None,
             mounting_rpy_deg: [0.0; 3],
             misalignment_rpy_deg: [0.0; 3],
@@ -684,6 +690,13 @@ impl NavConfig {
                 ),
             ));
         }
+        let base = self.time_base().map_err(|e| key_err("imu.time_base", e))?;
+        if base == crate::io::nav::TimeBase::GpsWeekAndSeconds && i.week_column.is_none() {
+            return Err(key_err(
+                "imu.time_base",
+                "gps-week-sow needs the week column: set imu.week_column (--imu-week-column)",
+            ));
+        }
         if let Some(r) = i.rate_hz
             && !(r.is_finite() && r > 0.0 && r <= 100_000.0)
         {
@@ -817,10 +830,20 @@ impl NavConfig {
         Ok(())
     }
 
-    /// The IMU stream options: time offset, mounting, gap policy, nominal interval.
+    /// The IMU time base.
+    pub fn time_base(&self) -> Result<crate::io::nav::TimeBase, String> {
+        self.imu
+            .time_base
+            .parse()
+            .map_err(|e: crate::io::nav::ParseTimeBaseError| e.to_string())
+    }
+
+    /// The IMU stream options: time offset, time base, mounting, gap policy, nominal
+    /// interval.
     pub fn stream_options(&self) -> ImuStreamOptions {
         let i = &self.imu;
         ImuStreamOptions {
+            time_base: self.time_base().unwrap_or_default(),
             time_shift_s: i.time_offset_s,
             mounting: Mounting {
                 rpy_deg: i.mounting_rpy_deg,

@@ -102,6 +102,8 @@ fn every_new_key_is_validated() {
         ("aids.zupt_sigma_m_s", "0", "> 0"),
         ("filter.gate", "chi2:2", "0 < P < 1"),
         ("filter.gate", "strict", "robust"),
+        ("imu.time_base", "unix", "gpst-unix"),
+        ("imu.time_base", "gps-week-sow", "week column"),
         ("outages.spec", "3x", ""),
     ];
     for (path, value, needle) in bad {
