@@ -92,6 +92,22 @@ pub const KEYS: &[Key] = &[
         "",
     ),
     key(
+        "imu.time_base",
+        "imu-time-base",
+        "BASE",
+        Text,
+        "IMU time column: gps-sow (GPS seconds of week), gps-week-sow (with a week column), gpst-unix (Unix seconds in GPS time), utc-unix (Unix seconds in UTC; leap seconds applied)",
+        "",
+    ),
+    key(
+        "imu.week_column",
+        "imu-week-column",
+        "COL",
+        Text,
+        "GPS week column of a rates CSV (header name or 1-based number), for gps-week-sow",
+        "\"week\"",
+    ),
+    key(
         "imu.rate_hz",
         "imu-rate",
         "HZ",
