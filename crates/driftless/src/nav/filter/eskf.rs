@@ -180,6 +180,51 @@ impl Eskf {
         std::array::from_fn(|i| self.p[i][i].max(0.0).sqrt())
     }
 
+    /// Re-initialise the navigation states: the position, velocity and attitude of `nav`
+    /// (its time is ignored; the filter's stays) with a diagonal covariance of the given
+    /// σ, uncorrelated with the sensor-error states, whose estimates and covariance are
+    /// kept. Used when the state has diverged from the measurements
+    /// ([`super::FilterConfig::gate_recovery_s`]).
+    pub fn reset_navigation(
+        &mut self,
+        nav: NavState,
+        sigma_pos_ned_m: Vec3,
+        sigma_vel_ned_m_s: Vec3,
+        sigma_att_rad: Vec3,
+    ) -> Result<(), NavError> {
+        let sig = sigma_pos_ned_m
+            .iter()
+            .chain(sigma_vel_ned_m_s.iter())
+            .chain(sigma_att_rad.iter());
+        let ok = [nav.lat_rad, nav.lon_rad, nav.height_m]
+            .iter()
+            .chain(nav.vel_ned_m_s.iter())
+            .chain(nav.q_bn.0.iter())
+            .all(|v| v.is_finite());
+        if !ok || !sig.clone().all(|s| s.is_finite() && *s > 0.0) {
+            return Err(NavError::InvalidMeasurement {
+                time_s: self.nav.time_s,
+                reason: format!("navigation reset to a non-finite state or σ: {nav:?}"),
+            });
+        }
+        let t = self.nav.time_s;
+        self.nav = NavState {
+            time_s: t,
+            q_bn: nav.q_bn.normalized(),
+            ..nav
+        };
+        for i in 0..9 {
+            for j in 0..N_STATES {
+                self.p[i][j] = 0.0;
+                self.p[j][i] = 0.0;
+            }
+        }
+        for (i, s) in sig.enumerate() {
+            self.p[i][i] = s * s;
+        }
+        Ok(())
+    }
+
     /// Last compensated angular rate ω̂_ib^b, rad/s.
     pub fn omega_ib_b_rad_s(&self) -> Vec3 {
         self.last_omega_b_rad_s

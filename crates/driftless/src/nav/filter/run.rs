@@ -26,7 +26,17 @@
 //!   τ = (t_fix − t_accept) − |(t_accept, t_fix] ∩ ⋃ windows|. When τ > R the fix is
 //!   applied with [`super::Gate::Off`] (counted in [`ForwardRun::gnss_forced`]): a state
 //!   that every fix contradicts for R seconds of GNSS coverage has diverged (e.g. after
-//!   an IMU fault) and the fixes are trusted over it.
+//!   an IMU fault) and the fixes are trusted over it. When that fix is a gross outlier
+//!   even for the default robust gate at its ceiling (the state is far off, not merely
+//!   over-confident), the navigation states are first re-initialised
+//!   ([`Eskf::reset_navigation`], counted in [`ForwardRun::gnss_resets`]): position from
+//!   the fix (lever arm removed); velocity from the chord to the previous fix when it is
+//!   at most 2R earlier (σ the chord's, at least 1 m/s), else zero with σ 10 m/s; roll
+//!   and pitch levelled from the mean specific force of the last second (exponential
+//!   mean, time constant 1 s; σ 5°, covering accelerations up to ≈ 0.9 m/s²), yaw kept
+//!   with σ at least 10°; the sensor-error states are kept. A gyro fault about a level
+//!   body's x or y axis (a roll or pitch jump) is thus undone; a yaw jump is not
+//!   observable this way and is left to the filter.
 //! * **First fix after an outage window**: under [`super::Gate::Robust`] it is applied
 //!   with the robust weight but never rejected ([`super::Gate::never_reject`]), so an
 //!   outage is never lengthened by rejected fixes because the window was long. Under
@@ -66,6 +76,7 @@ use super::eskf::{Eskf, UpdateKind, UpdateOutcome};
 use super::model::{FilterConfig, Transition};
 use super::state::{ATT, BG, Cov, N_STATES, PackedCov, SensorErrors, VEL, pack};
 use crate::io::nav::GnssFixes;
+use crate::nav::attitude::Euler;
 use crate::nav::earth;
 use crate::nav::mechanization::{ImuIncrement, NavState};
 
@@ -172,6 +183,9 @@ pub struct ForwardRun {
     /// Position fixes applied without the gate by the gate-recovery rule
     /// ([`FilterConfig::gate_recovery_s`]).
     pub gnss_forced: usize,
+    /// Forced fixes before which the navigation states were re-initialised (module docs;
+    /// a subset of `gnss_forced`).
+    pub gnss_resets: usize,
     /// Measurements accepted.
     pub gnss_accepted: usize,
     /// NHC updates accepted ([`super::aids`]).
@@ -283,6 +297,10 @@ struct Ctx<'a> {
     last_position_accept_s: f64,
     /// Time of the latest fix handed to [`Ctx::apply_fix`] (the start time before any).
     last_fix_s: f64,
+    /// That fix: (time, (lat, lon, h), horizontal σ after the quality scaling).
+    prev_fix: Option<(f64, (f64, f64, f64), f64)>,
+    /// Exponential mean (time constant 1 s) of the raw specific force, body, m/s².
+    f_mean_b: Option<Vec3>,
 }
 
 impl Ctx<'_> {
@@ -318,6 +336,54 @@ impl Ctx<'_> {
         (t1 - t0 - inside).max(0.0)
     }
 
+    /// Re-initialise the navigation states at the fix `llh` (module docs, gate recovery).
+    fn reset_to_fix(
+        &self,
+        f: &mut Eskf,
+        llh: [f64; 3],
+        sigma: Vec3,
+        prev_fix: Option<(f64, (f64, f64, f64), f64)>,
+    ) -> Result<(), NavError> {
+        let t = f.nav().time_s;
+        let yaw = Euler::from_dcm(&f.nav().q_bn.to_dcm()).yaw_rad;
+        let (roll, pitch) = match self.f_mean_b {
+            Some(fm) if norm(fm) > 1.0 => ((-fm[1]).atan2(-fm[2]), fm[0].atan2(fm[1].hypot(fm[2]))),
+            _ => (0.0, 0.0),
+        };
+        let q_bn = Euler {
+            roll_rad: roll,
+            pitch_rad: pitch,
+            yaw_rad: yaw,
+        }
+        .to_quat();
+        let l_n = q_bn.rotate(self.cfg.lever_arm_b_m);
+        let rm = earth::meridian_radius_m(llh[0]) + llh[2];
+        let rn = earth::prime_vertical_radius_m(llh[0]) + llh[2];
+        let max_chord_s = 2.0 * self.cfg.gate_recovery_s.unwrap_or(0.0);
+        let (vel, sigma_v) = match prev_fix {
+            Some((tp, p, sp)) if t - tp > 0.0 && t - tp <= max_chord_s => {
+                let d = earth::ned_offset_m(p, (llh[0], llh[1], llh[2]));
+                let dt = t - tp;
+                (
+                    d.map(|x| x / dt),
+                    (sp.hypot(sigma[0].max(sigma[1])) / dt).max(1.0),
+                )
+            }
+            _ => ([0.0; 3], 10.0),
+        };
+        let nav = NavState {
+            time_s: t,
+            lat_rad: llh[0] - l_n[0] / rm,
+            lon_rad: llh[1] - l_n[1] / (rn * llh[0].cos()),
+            height_m: llh[2] + l_n[2],
+            vel_ned_m_s: vel,
+            q_bn,
+        };
+        let sigma_yaw = f.std()[ATT + 2].max(10f64.to_radians());
+        let tilt = 5f64.to_radians();
+        f.reset_navigation(nav, sigma, [sigma_v; 3], [tilt, tilt, sigma_yaw])
+    }
+
     /// Apply fix `g` at the current filter epoch and refresh the last record.
     fn apply_fix(&mut self, f: &mut Eskf, g: usize) -> Result<(), NavError> {
         let gn = self.gnss;
@@ -335,17 +401,26 @@ impl Ctx<'_> {
             .iter()
             .any(|&(_, b)| b >= self.last_fix_s && b < t_fix);
         self.last_fix_s = t_fix;
+        let llh = [gn.lat_rad[g], gn.lon_rad[g], gn.height_m[g]];
+        let prev_fix =
+            self.prev_fix
+                .replace((t_fix, (llh[0], llh[1], llh[2]), sigma[0].max(sigma[1])));
         let gate = f.gate();
         if forced {
+            let mut trial = f.clone();
+            trial.set_gate(super::Gate::default());
+            let gross = trial
+                .update_position(llh, sigma, self.cfg.lever_arm_b_m)
+                .map_or(true, |o| !o.accepted);
+            if gross {
+                self.reset_to_fix(f, llh, sigma, prev_fix)?;
+                self.run.gnss_resets += 1;
+            }
             f.set_gate(super::Gate::Off);
         } else if after_window && matches!(gate, super::Gate::Robust { .. }) {
             f.set_gate(gate.never_reject());
         }
-        let o = f.update_position(
-            [gn.lat_rad[g], gn.lon_rad[g], gn.height_m[g]],
-            sigma,
-            self.cfg.lever_arm_b_m,
-        );
+        let o = f.update_position(llh, sigma, self.cfg.lever_arm_b_m);
         f.set_gate(gate);
         let o = o?;
         if o.accepted {
@@ -453,6 +528,8 @@ pub fn run_forward_observed(
         gnss_speed: None,
         last_position_accept_s: t0,
         last_fix_s: t0,
+        prev_fix: None,
+        f_mean_b: None,
         run: ForwardRun {
             epochs: Vec::with_capacity(if keep_epochs {
                 imu.len() - start + gnss.len() + 1
@@ -467,6 +544,7 @@ pub fn run_forward_observed(
             gnss_rejected: 0,
             gnss_inflated: 0,
             gnss_forced: 0,
+            gnss_resets: 0,
             gnss_accepted: 0,
             nhc_applied: 0,
             zupt_applied: 0,
@@ -526,6 +604,14 @@ pub fn run_forward_observed(
                 reason: format!("gap of {dt} s after {t_prev} s (nominal interval {nominal_dt} s)"),
             });
         }
+        let f_now = inc.dvel_m_s.map(|v| v / dt);
+        ctx.f_mean_b = Some(match ctx.f_mean_b {
+            Some(m) => {
+                let a = dt.min(1.0);
+                std::array::from_fn(|k| m[k] + a * (f_now[k] - m[k]))
+            }
+            None => f_now,
+        });
         let mut rest = ImuIncrement { dt_s: dt, ..*inc };
         let mut t_start = t_prev;
         let mut done = false;
