@@ -578,3 +578,37 @@ fn given_yaw_starts_at_rest_and_too_slow_is_a_clear_error() {
         "names the speed reached: {e}"
     );
 }
+
+/// `accept_quality` skips the fixes with other RTKLIB flags (and says how many).
+#[test]
+fn quality_filter_skips_other_flags() {
+    let mut w = walk_data();
+    // Every 4th fix a float solution.
+    for (i, q) in w.gnss.quality.iter_mut().enumerate() {
+        if i % 4 == 0 {
+            *q = driftless::io::nav::quality::FLOAT;
+        }
+    }
+    let n_float = w.gnss.quality.iter().filter(|&&q| q == 2).count();
+    let mut cfg = consumer_config();
+    cfg.accept_quality = vec![driftless::io::nav::quality::FIX];
+    let run = run_forward(&w.imu, &w.gnss, initial(&w.traj), &cfg).expect("run");
+    assert_eq!(run.gnss_quality_skipped, n_float);
+    let floats: Vec<f64> = (0..w.gnss.len())
+        .filter(|&i| w.gnss.quality[i] == 2)
+        .map(|i| w.gnss.time_s[i])
+        .collect();
+    assert!(
+        position_outcomes(&run)
+            .iter()
+            .all(|o| !floats.iter().any(|t| (t - o.time_s).abs() < 1e-9))
+    );
+    assert_eq!(
+        run.gnss_accepted + run.gnss_rejected,
+        w.gnss.len() - n_float
+    );
+    // Empty list: every flag used.
+    cfg.accept_quality.clear();
+    let run = run_forward(&w.imu, &w.gnss, initial(&w.traj), &cfg).expect("run");
+    assert_eq!(run.gnss_quality_skipped, 0);
+}

@@ -541,27 +541,10 @@ impl Eskf {
                     true
                 } else {
                     let lambda_max = max_sigma_scale * max_sigma_scale;
-                    let (inv_max, nis_max) = solve(lambda_max)?;
-                    if nis_max > c {
-                        // Even the ceiling leaves the innovation beyond c.
-                        lambda = lambda_max;
-                        s_inv = inv_max;
-                        nis_max <= chi2_quantile(p_reject, M as f64)
-                    } else {
-                        // Bisection on ln λ for q(λ) = c, q decreasing in λ.
-                        let (mut lo, mut hi) = (0.0f64, lambda_max.ln());
-                        for _ in 0..50 {
-                            let mid = 0.5 * (lo + hi);
-                            if solve(mid.exp())?.1 > c {
-                                lo = mid;
-                            } else {
-                                hi = mid;
-                            }
-                        }
-                        lambda = hi.exp();
-                        s_inv = solve(lambda)?.0;
-                        true
-                    }
+                    let (_, nis_max) = solve(lambda_max)?;
+                    lambda = (nis / c).min(lambda_max);
+                    s_inv = solve(lambda)?.0;
+                    nis_max <= chi2_quantile(p_reject, M as f64)
                 }
             }
         };

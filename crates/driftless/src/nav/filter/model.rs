@@ -252,17 +252,22 @@ pub enum Gate {
         /// Probability of the quantile.
         p: f64,
     },
-    /// Robust down-weighting by a scalar inflation of R (the Mahalanobis-distance
-    /// M-estimator of Chang 2014, J. Geodesy 88:391–401, a multivariate form of Huber
-    /// 1964's down-weighting; cf. the IGG scheme of Yang 1999, whose rejection zone is
-    /// replaced here by the ceiling test):
+    /// Robust down-weighting by a scalar inflation of R on the Mahalanobis distance of
+    /// the innovation (Huber 1964's M-estimator weight c/q in its multivariate, NIS form;
+    /// λ = q/c is the R-dominated solution of the condition yᵀ(H P Hᵀ + λR)⁻¹y = c of
+    /// the robust Kalman filter of Chang 2014, J. Geodesy 88:391–401; like the IGG
+    /// scheme of Yang 1999 it has an unchanged, a down-weighted and a rejected zone, the
+    /// last decided here by the ceiling test; outlier detection on the innovations as in
+    /// Groves 2013 §17.3):
     ///
     /// * c = χ²_{p_inflate}(m). If q ≤ c the update is the ordinary one (λ = 1).
-    /// * Otherwise R is replaced by λR with λ > 1 the solution of
-    ///   yᵀ(H P Hᵀ + λR)⁻¹y = c (q(λ) decreases monotonically in λ; solved by bisection
-    ///   on ln λ), so the measurement's weight falls smoothly with the size of the
-    ///   innovation instead of dropping to zero; λ is capped at λ_max =
-    ///   `max_sigma_scale`² (σ inflated at most `max_sigma_scale` times).
+    /// * Otherwise R is replaced by λR with λ = min(q/c, λ_max), λ_max =
+    ///   `max_sigma_scale`² (σ inflated at most `max_sigma_scale` times): Huber's weight
+    ///   c/q applied to the squared normalized residual. When R dominates S the inflated
+    ///   NIS is ≈ c — the measurement's weight falls smoothly with the size of its
+    ///   innovation instead of dropping to zero; when H P Hᵀ dominates (the prediction,
+    ///   not the fix, is uncertain, e.g. after an outage) inflating R changes S little
+    ///   and a fix that corrects a drifted state keeps its weight.
     /// * Rejection (state and P untouched) only when the innovation is inconsistent even
     ///   at the ceiling: yᵀ(H P Hᵀ + λ_max R)⁻¹y > χ²_{p_reject}(m). With the default
     ///   `max_sigma_scale` = 100 a fix with a 1-cm formal σ is still used (weighted as
