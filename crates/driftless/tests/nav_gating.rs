@@ -8,7 +8,7 @@
 //! rover). Run with `cargo test --release`; the measured figures are printed.
 
 use driftless::io::nav::GnssFixes;
-use driftless::nav::attitude::{Euler, Quat};
+use driftless::nav::attitude::Euler;
 use driftless::nav::earth;
 use driftless::nav::filter::{
     FilterConfig, ForwardRun, Gate, GaussMarkov, ImuNoise, InitialState, SensorErrors, UpdateKind,
@@ -23,6 +23,10 @@ use driftless::sim::ideal_imu::{DriveSegment, LandVehicle, Trajectory, ideal_inc
 use driftless::sim::rng::Rng;
 use driftless_model::linalg::{Mat3, Vec3};
 use driftless_model::units::{DEG, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H, MILLI_G};
+
+#[path = "common/nav_sim.rs"]
+mod nav_sim;
+use nav_sim::perturbed_start;
 
 const DT: f64 = 0.005;
 const LAT0: f64 = 30.0 * DEG;
@@ -128,22 +132,7 @@ fn consumer_config() -> FilterConfig {
 
 /// Truth at t = 0 (at rest) perturbed by 0.3 m, 0.05 m/s, (0.3°, −0.3°, 2°).
 fn initial<T: Trajectory>(traj: &T) -> InitialState {
-    let p = traj.point(0.0);
-    let mut nav = p.nav_state(0.0);
-    let rm = earth::meridian_radius_m(nav.lat_rad) + nav.height_m;
-    nav.lat_rad += 0.3 / rm;
-    nav.vel_ned_m_s[1] += 0.05;
-    nav.q_bn = Quat::from_rotation_vector([0.3 * DEG, -0.3 * DEG, 2.0 * DEG])
-        .mul(&nav.q_bn)
-        .normalized();
-    InitialState {
-        nav,
-        sensors: SensorErrors::default(),
-        sigma_pos_ned_m: [1.0; 3],
-        sigma_vel_ned_m_s: [0.3; 3],
-        sigma_att_rad: [1.0 * DEG, 1.0 * DEG, 5.0 * DEG],
-        sigma_sensors: None,
-    }
+    perturbed_start(traj, 0.05, [0.3 * DEG, -0.3 * DEG, 2.0 * DEG], 0.3)
 }
 
 /// Horizontal error of the estimated IMU position against the truth, m.

@@ -116,7 +116,9 @@ impl SessionConfig {
     /// Settings for `shared/data/drive/drive_0708` (roof-mounted car, consumer IMU):
     /// antenna (0, −0.05, 0) m from the IMU in the vehicle frame; consumer-MEMS noise
     /// with the white-noise terms ×10 for the vehicle's vibration; RTK σ floored at
-    /// 3 cm / 6 cm; non-holonomic constraint and standstill ZUPT/ZARU on; smoother on.
+    /// 3 cm / 6 cm; non-holonomic constraint and standstill ZUPT/ZARU on; smoother on;
+    /// gate `chi2:0.9999` and heading from the first fix above 3 m/s (as when it was
+    /// tuned).
     /// The ×10 and the floor were chosen on this drive from a 12-point grid
     /// ({1, 3, 10}× noise × {none, 3 cm} floor × aids off/on; VALIDATION.md lists it),
     /// so the drive figures are in-sample.
@@ -130,7 +132,11 @@ impl SessionConfig {
         let mut c = SessionConfig::new(f);
         c.sigma_floor_m = Some((0.03, 0.06));
         c.smooth = true;
-        // The drive's figures were measured starting at the first fix above 3 m/s.
+        // The preset was tuned (noise ×10, 3-cm floor) with the χ² test and the heading
+        // taken at the first fix above 3 m/s; both are kept so its figures stay what the
+        // tuning gave. With the default robust gate instead: full-RTK RMS 0.042 m,
+        // mean end-of-outage error 27.97 m (VALIDATION.md).
+        c.filter.gate = super::filter::model::Gate::Chi2 { p: 0.9999 };
         c.min_speed_m_s = 3.0;
         c
     }
