@@ -11,8 +11,7 @@ use driftless::io::nav::GnssFixes;
 use driftless::nav::attitude::Euler;
 use driftless::nav::earth;
 use driftless::nav::filter::{
-    FilterConfig, ForwardRun, Gate, GaussMarkov, ImuNoise, InitialState, SensorErrors, UpdateKind,
-    run_forward,
+    FilterConfig, ForwardRun, Gate, GaussMarkov, ImuNoise, InitialState, UpdateKind, run_forward,
 };
 use driftless::nav::mechanization::{ImuIncrement, NavState};
 use driftless::nav::outage::OutageWindow;
