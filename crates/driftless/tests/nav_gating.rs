@@ -18,14 +18,13 @@ use driftless::nav::outage::OutageWindow;
 use driftless::nav::pipeline::ImuStream;
 use driftless::nav::session::{SessionConfig, run_session};
 use driftless::sim::gnss::{GnssSimConfig, simulate_gnss};
-use driftless::sim::ideal_imu::{DriveSegment, LandVehicle, Trajectory, ideal_increments};
-use driftless::sim::rng::Rng;
+use driftless::sim::ideal_imu::{DriveSegment, LandVehicle, Trajectory};
 use driftless_model::linalg::{Mat3, Vec3};
 use driftless_model::units::{DEG, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H, MILLI_G};
 
 #[path = "common/nav_sim.rs"]
 mod nav_sim;
-use nav_sim::perturbed_start;
+use nav_sim::{perturbed_start, simulate_imu_with};
 
 const DT: f64 = 0.005;
 const LAT0: f64 = 30.0 * DEG;
@@ -78,24 +77,6 @@ fn walk() -> (LandVehicle, f64) {
     );
     let d = t.duration_s();
     (t, d)
-}
-
-/// Raw IMU over (−DT, duration]: ideal increments plus biases and white noise.
-fn simulate_imu<T: Trajectory>(traj: &T, duration_s: f64, seed: u64) -> Vec<ImuIncrement> {
-    let n = (duration_s / DT).round() as usize + 1;
-    let mut rng = Rng::seed_from_u64(seed);
-    let (sg, sa) = (ARW * DT.sqrt(), VRW * DT.sqrt());
-    ideal_increments(traj, 0.0, DT, n)
-        .map(|i| ImuIncrement {
-            dtheta_rad: std::array::from_fn(|k| {
-                i.dtheta_rad[k] + GYRO_BIAS[k] * DT + sg * rng.normal()
-            }),
-            dvel_m_s: std::array::from_fn(|k| {
-                i.dvel_m_s[k] + ACCEL_BIAS[k] * DT + sa * rng.normal()
-            }),
-            ..i
-        })
-        .collect()
 }
 
 /// 4-Hz fixes at the IMU with 1 cm white + 25/40 cm correlated error, reported σ 1 cm.
@@ -175,7 +156,7 @@ struct Walk {
 
 fn walk_data() -> Walk {
     let (traj, duration_s) = walk();
-    let imu = simulate_imu(&traj, duration_s, 31);
+    let imu = simulate_imu_with(&traj, duration_s, 31, [GYRO_BIAS, ACCEL_BIAS], [ARW, VRW]);
     let gnss = simulate_rtk(&traj, duration_s, 32);
     Walk {
         traj,

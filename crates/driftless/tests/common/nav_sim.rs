@@ -67,17 +67,27 @@ pub fn drive() -> impl Trajectory {
 
 /// Raw IMU: ideal increments over (−DT, duration] plus biases and white noise.
 pub fn simulate_imu<T: Trajectory>(traj: &T, duration_s: f64, seed: u64) -> Vec<ImuIncrement> {
+    simulate_imu_with(traj, duration_s, seed, [GYRO_BIAS, ACCEL_BIAS], [ARW, VRW])
+}
+
+/// [`simulate_imu`] with other constant biases `[gyro rad/s, accel m/s²]` and white
+/// noise `[ARW rad/√s, VRW m/s/√s]`.
+pub fn simulate_imu_with<T: Trajectory>(
+    traj: &T,
+    duration_s: f64,
+    seed: u64,
+    bias: [Vec3; 2],
+    white: [f64; 2],
+) -> Vec<ImuIncrement> {
     let n = (duration_s / DT).round() as usize + 1;
     let mut rng = Rng::seed_from_u64(seed);
-    let (sg, sa) = (ARW * DT.sqrt(), VRW * DT.sqrt());
+    let (sg, sa) = (white[0] * DT.sqrt(), white[1] * DT.sqrt());
     ideal_increments(traj, 0.0, DT, n)
         .map(|i| ImuIncrement {
             dtheta_rad: std::array::from_fn(|k| {
-                i.dtheta_rad[k] + GYRO_BIAS[k] * DT + sg * rng.normal()
+                i.dtheta_rad[k] + bias[0][k] * DT + sg * rng.normal()
             }),
-            dvel_m_s: std::array::from_fn(|k| {
-                i.dvel_m_s[k] + ACCEL_BIAS[k] * DT + sa * rng.normal()
-            }),
+            dvel_m_s: std::array::from_fn(|k| i.dvel_m_s[k] + bias[1][k] * DT + sa * rng.normal()),
             ..i
         })
         .collect()
