@@ -160,7 +160,8 @@ fn outage_errors_match_a_known_error_growth() {
     );
     assert!((o.max_horizontal_m - 450.0).abs() < 1e-6);
     assert_eq!(o.max_time_s, o.end_time_s);
-    assert_eq!(o.epochs, 301);
+    // Window (a, a + 30 s] at 10 Hz: 300 epochs (the epoch at a is still aided).
+    assert_eq!(o.epochs, 300);
     // Growth series: every second, 0 … 30 s, 0.5·τ² each.
     assert_eq!(o.growth.len(), 31);
     for g in &o.growth {
@@ -195,7 +196,7 @@ fn outage_errors_match_a_known_error_growth() {
         },
     )
     .unwrap();
-    assert_eq!(all.outages[0].growth.len(), 301);
+    assert_eq!(all.outages[0].growth.len(), 300);
 }
 
 #[test]

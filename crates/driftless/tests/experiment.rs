@@ -50,8 +50,8 @@ fn builtin_monte_carlo_thermal_model_pays() {
         assert_eq!(cs.failed_runs, 0, "{:?}: {:?}", c, cs.first_failure);
         cs.forward_mean_end_m.expect("spread")
     };
-    let (b, c) = (spread(Case::Room), spread(Case::Thermal));
-    eprintln!("(b) {b:?}\n(c) {c:?}");
+    let (a, b, c) = (spread(Case::Raw), spread(Case::Room), spread(Case::Thermal));
+    eprintln!("(a) {a:?}\n(b) {b:?}\n(c) {c:?}");
     assert_eq!((b.n, c.n), (20, 20));
     assert!(c.mean < b.mean, "(c) {} m vs (b) {} m", c.mean, b.mean);
     let q = s.ratio_room_over_thermal.expect("ratio");

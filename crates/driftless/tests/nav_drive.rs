@@ -2,7 +2,7 @@
 //! 4 Hz): full-RTK accuracy and 60-s outages, against the RTK fixes themselves.
 
 use driftless::io::nav::kfgins::GnssReadOptions;
-use driftless::nav::filter::model::FilterConfig;
+use driftless::nav::filter::model::{FilterConfig, Gate};
 use driftless::nav::outage::OutageSpec;
 use driftless::nav::pipeline::{
     GnssOutsideImu, ImuStreamOptions, Mounting, TaggedCsvOptions, imu_from_tagged_csv_files,
@@ -89,10 +89,21 @@ fn drive_0708_full_rtk_and_outages() {
     let plain = SessionConfig::new(FilterConfig::new(consumer_mems_noise(), LEVER_ARM_B_M));
     let p = run_session(&imu, &all.fixes, &plain).unwrap();
     eprintln!(
-        "defaults (no aids, file σ): full-RTK one-step RMS {:.3} m, {} rejected, {} forced",
+        "defaults (no aids, file σ, robust gate): full-RTK one-step RMS {:.3} m, {} rejected, \
+         {} inflated, {} forced",
         p.horizontal_rms_m.map_or(f64::NAN, |x| x.0),
         p.run.gnss_rejected,
+        p.run.gnss_inflated,
         p.run.gnss_forced
+    );
+    let mut chi2 = plain.clone();
+    chi2.filter.gate = Gate::Chi2 { p: 0.9999 };
+    let c = run_session(&imu, &all.fixes, &chi2).unwrap();
+    eprintln!(
+        "defaults with chi2:0.9999: full-RTK one-step RMS {:.3} m, {} rejected, {} forced",
+        c.horizontal_rms_m.map_or(f64::NAN, |x| x.0),
+        c.run.gnss_rejected,
+        c.run.gnss_forced
     );
 
     let mut cfg = tuned_config();
@@ -148,6 +159,26 @@ fn drive_0708_full_rtk_and_outages() {
         ends.len()
     );
     assert_eq!(ends.len(), 6);
+    // The preset under the default robust gate instead of its χ² test (reported only).
+    let mut rob = tuned_config();
+    rob.smooth = false;
+    rob.filter.gate = Gate::default();
+    let r_full = run_session(&imu, &all.fixes, &rob).unwrap();
+    rob.outages = ocfg.outages.clone();
+    let r_out = run_session(&imu, &all.fixes, &rob).unwrap();
+    let r_ends: Vec<f64> = r_out
+        .outages
+        .iter()
+        .filter_map(|o| o.end_horizontal_m)
+        .collect();
+    eprintln!(
+        "preset with the robust gate: full-RTK RMS {:.3} m ({} rejected, {} inflated); mean \
+         end-of-outage error {:.2} m ({r_ends:.2?})",
+        r_full.horizontal_rms_m.map_or(f64::NAN, |x| x.0),
+        r_full.run.gnss_rejected,
+        r_full.run.gnss_inflated,
+        r_ends.iter().sum::<f64>() / r_ends.len().max(1) as f64
+    );
     assert!(mean <= 30.0, "mean end-of-outage error {mean} m (bar 30 m)");
 }
 

@@ -8,7 +8,7 @@ use driftless::nav::attitude::{Euler, Quat};
 use driftless::nav::earth;
 use driftless::nav::filter::state::{check_covariance, unpack};
 use driftless::nav::filter::{
-    AlignConfig, Eskf, ForwardRun, InitialState, NavError, coarse_align_static,
+    AlignConfig, Eskf, ForwardRun, Gate, InitialState, NavError, coarse_align_static,
     heading_from_gnss_velocity, run_forward,
 };
 use driftless::nav::mechanization::ImuIncrement;
@@ -217,7 +217,8 @@ fn outage_error_growth_is_covered_by_sigma() {
     assert!(ea[0].hypot(ea[1]) < 0.05, "recovered {ea:?}");
 }
 
-/// (d) A 50 m jump in one fix is rejected by the χ² gate; the solution is unaffected.
+/// (d) A 50 m jump in one fix is rejected by the default (robust) gate; the solution is
+/// unaffected.
 #[test]
 fn gnss_jump_is_rejected() {
     let mut sc = scenario(300.0);
@@ -240,7 +241,7 @@ fn gnss_jump_is_rejected() {
     assert!(rms < 0.035);
     // Without the gate the jump pulls the solution off.
     let mut open = cfg.clone();
-    open.chi2_gate = None;
+    open.gate = Gate::Off;
     let run = run_forward(&sc.imu, &sc.gnss, initial(&sc.traj), &open).expect("forward run");
     let e = run
         .epochs

@@ -9,7 +9,7 @@ use driftless::io::nav::{
 use driftless::io::{Channel, ImuLog, Quantity};
 use driftless::nav::attitude::Euler;
 use driftless::nav::outage::{
-    OutageError, OutageItem, OutageSpec, OutageStart, OutageWindow, TimeSpan, resolve,
+    OutageError, OutageItem, OutageSpec, OutageStart, OutageWindow, TimeSpan, is_masked, resolve,
 };
 use driftless::nav::pipeline::{
     GnssOutsideImu, ImuGapPolicy, ImuStream, ImuStreamOptions, Mounting, PipelineError,
@@ -83,9 +83,11 @@ fn outage_explicit_windows() {
             .unwrap()
             .is_empty()
     );
-    // Closed interval semantics.
-    assert!(w(10.0, 70.0).contains(10.0) && w(10.0, 70.0).contains(70.0));
+    // Half-open (s, e]: a fix exactly at s is used, one exactly at e is withheld.
+    assert!(!w(10.0, 70.0).contains(10.0) && w(10.0, 70.0).contains(70.0));
+    assert!(w(10.0, 70.0).contains(10.001) && w(10.0, 70.0).contains(69.999));
     assert!(!w(10.0, 70.0).contains(70.001) && !w(10.0, 70.0).contains(9.999));
+    assert!(is_masked(&[w(10.0, 70.0)], 70.0) && !is_masked(&[w(10.0, 70.0)], 10.0));
 }
 
 #[test]
@@ -462,19 +464,15 @@ fn gnss_before_imu_and_masking() {
         matches!(e, PipelineError::GnssOutsideImu { index: 0, time_s, .. } if time_s == 98.0),
         "{e}"
     );
-    // Outage 2 s after the first usable epoch (100 s), 3 s long: [102, 105] withheld,
-    // both ends included: 102.0, 102.5, …, 105.0 = 7 epochs.
+    // Outage 2 s after the first usable epoch (100 s), 3 s long: (102, 105] withheld:
+    // 102.5, 103.0, …, 105.0 = 6 epochs; the fix at 102.0 is kept.
     let spec: OutageSpec = "2+3".parse().unwrap();
     let sel = select_gnss(&g, &imu, &spec, GnssOutsideImu::Drop).unwrap();
     assert_eq!(sel.windows, vec![w(102.0, 105.0)]);
-    assert_eq!(sel.masked, 7);
-    assert_eq!(sel.fixes.len(), 14);
-    assert!(
-        sel.fixes
-            .time_s
-            .iter()
-            .all(|&t| !(102.0..=105.0).contains(&t))
-    );
+    assert_eq!(sel.masked, 6);
+    assert_eq!(sel.fixes.len(), 15);
+    assert!(sel.fixes.time_s.iter().all(|&t| !(t > 102.0 && t <= 105.0)));
+    assert!(sel.fixes.time_s.contains(&102.0) && sel.fixes.time_s.contains(&105.5));
     // Outage outside the usable data is an error, not silently ignored.
     let spec: OutageSpec = "8+5".parse().unwrap();
     assert!(matches!(
@@ -1037,7 +1035,7 @@ fn drive_0708_cut_edges_match_whole() {
     let dir = data_dir().join("drive/drive_0708");
     let csv = std::fs::read_to_string(dir.join("imu_1934.csv")).unwrap();
     let tag = read_rtklib_tag_file(dir.join("imu_1934.csv.tag"), FposSize::Auto).unwrap();
-    let opts = TaggedCsvOptions::drive_0708();
+    let opts = drive_0708_options();
     let whole = imu_from_tagged_csv(csv.as_bytes(), "imu.csv", &tag, &opts).unwrap();
     assert!(whole.notes.is_empty());
     let lines: Vec<&str> = csv.lines().collect();

@@ -19,7 +19,7 @@
 //! then taken from the central difference of the fixes around the first epoch above
 //! 0.8 m/s). Three filter variants are measured: **A** the default χ² gate, **B** the
 //! fixes' σ floored at 0.1 m / 0.2 m (`SessionConfig::sigma_floor_m`), **C** no gate
-//! (`FilterConfig::chi2_gate = None`).
+//! (`FilterConfig::gate = Gate::Off`).
 //!
 //! **Figures** (per variant, pooled over the 20 seeds):
 //! (a) share of GNSS fixes rejected by the gate in the full-GNSS run,
@@ -82,6 +82,7 @@ use std::time::Instant;
 use driftless::io::nav::{NavSolution, quality};
 use driftless::nav::attitude::Euler;
 use driftless::nav::earth::ned_offset_m;
+use driftless::nav::filter::model::Gate;
 use driftless::nav::filter::state::POS;
 use driftless::nav::filter::{
     FilterConfig, ForwardRun, GaussMarkov, ImuNoise, UpdateKind, run_forward,
@@ -89,7 +90,7 @@ use driftless::nav::filter::{
 use driftless::nav::mechanization::mechanize;
 use driftless::nav::outage::OutageWindow;
 use driftless::nav::pipeline::ImuStream;
-use driftless::nav::session::{SessionConfig, initialise_in_motion, prime_gyro_bias, run_session};
+use driftless::nav::session::{SessionConfig, initialise, prime_gyro_bias, run_session};
 use driftless::sim::presets::Preset;
 use driftless::sim::scenario::{ErrorTerms, Scenario, Simulation};
 
@@ -152,6 +153,8 @@ fn walk_noise() -> ImuNoise {
 /// part of the problem limits today's filter.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Variant {
+    /// The library's defaults: robust gate, alignment at walking speed.
+    Default,
     Chi2Gate,
     SigmaFloor,
     NoGate,
@@ -170,7 +173,12 @@ enum Variant {
 }
 
 impl Variant {
-    const STUDY: [Variant; 3] = [Variant::Chi2Gate, Variant::SigmaFloor, Variant::NoGate];
+    const STUDY: [Variant; 4] = [
+        Variant::Default,
+        Variant::Chi2Gate,
+        Variant::SigmaFloor,
+        Variant::NoGate,
+    ];
     const DIAGNOSTICS: [Variant; 5] = [
         Variant::FloorAtMotion,
         Variant::RigidAntenna,
@@ -181,7 +189,8 @@ impl Variant {
 
     fn label(self) -> &'static str {
         match self {
-            Variant::Chi2Gate => "A default χ² gate",
+            Variant::Default => "defaults (robust gate)",
+            Variant::Chi2Gate => "A χ² gate (chi2:0.9999)",
             Variant::SigmaFloor => "B σ floor 0.1/0.2 m",
             Variant::NoGate => "C no gate",
             Variant::FloorAtMotion => "D σ floor 0.3/0.3 m",
@@ -194,11 +203,18 @@ impl Variant {
 
     fn config(self, lever_b_m: [f64; 3]) -> SessionConfig {
         let mut c = SessionConfig::new(FilterConfig::new(walk_noise(), lever_b_m));
+        if self == Variant::Default {
+            return c;
+        }
         c.min_speed_m_s = MIN_SPEED_M_S;
+        c.filter.gate = Gate::Chi2 { p: 0.9999 };
         match self {
-            Variant::Chi2Gate | Variant::RigidAntenna | Variant::Chi2GateTrueHeading => {}
+            Variant::Default
+            | Variant::Chi2Gate
+            | Variant::RigidAntenna
+            | Variant::Chi2GateTrueHeading => {}
             Variant::SigmaFloor => c.sigma_floor_m = Some((0.1, 0.2)),
-            Variant::NoGate => c.filter.chi2_gate = None,
+            Variant::NoGate => c.filter.gate = Gate::Off,
             Variant::FloorAtMotion
             | Variant::FloorAtMotionNoiseOnly
             | Variant::FloorAtMotionTrueHeading => c.sigma_floor_m = Some((0.3, 0.3)),
@@ -321,7 +337,7 @@ fn forward(imu: &ImuStream, sim: &Simulation, cfg: &SessionConfig, true_attitude
         }
     }
     let primed = prime_gyro_bias(imu, cfg.static_prime_s);
-    let mut init = initialise_in_motion(imu, &floored, cfg, primed).expect("initial state");
+    let mut init = initialise(imu, &floored, cfg, primed).expect("initial state");
     let k = truth_index(&sim.truth, init.nav.time_s);
     let [r, p, y] = sim.truth.roll_pitch_yaw_rad[k];
     init.nav.q_bn = Euler {
@@ -735,11 +751,8 @@ fn walk_simulation_matches_the_scenario_and_the_filter_runs() {
 
 /// The study's bars under the default filter (module documentation).
 #[test]
-#[ignore = "waits for the filter's robust default gate (σ inflation instead of χ² rejection) \
-            and walking-speed alignment: today's χ² gate rejects most fixes of a hand-held \
-            RTK antenna and the outage ends miss 3σ (table in VALIDATION.md)"]
 fn walk_study_meets_the_bars() {
-    let p = study(&[Variant::Chi2Gate])[0];
+    let p = study(&[Variant::Default])[0];
     assert!(
         p.rejected_share < 0.02,
         "(a) {:.2} % of the fixes rejected by the gate (bar < 2 %)",
@@ -768,7 +781,7 @@ fn walk_study_meets_the_bars() {
 fn measure_walk_filter_variants() {
     let clock = Instant::now();
     let rows = study(&Variant::STUDY);
-    assert_eq!(rows.len(), 3);
+    assert_eq!(rows.len(), 4);
     if std::env::var_os("WALK_DIAGNOSTICS").is_some() {
         study(&Variant::DIAGNOSTICS);
     }

@@ -19,11 +19,11 @@
 //! * **heading error** = wrap(ψ_sol − ψ_ref) into (−180°, 180°], where both yaws are
 //!   known.
 //!
-//! # One outage (closed window [a, b])
+//! # One outage (half-open window (a, b], as [`OutageWindow`])
 //!
-//! The solution epochs t ∈ [a, b] are dead reckoning (GNSS withheld). The
-//! **end-of-outage** errors are taken at the last of them, t_end ≤ b (the window's
-//! convention: the first fix used again lies after b); the **maximum horizontal error**
+//! The solution epochs a < t ≤ b are dead reckoning (GNSS withheld; the fix at a is
+//! the last one used). The **end-of-outage** errors are taken at the last of them,
+//! t_end ≤ b (the first fix used again lies after b); the **maximum horizontal error**
 //! is over all of them with a reference, the end included. The **error growth** series is
 //! (t − a, horizontal error) every `growth_step_s` of the window plus the end epoch.
 //!
@@ -254,7 +254,7 @@ pub fn outage_errors(
     let mut outages = Vec::with_capacity(windows.len());
     for &w in windows {
         let t = &solution.time_s;
-        let i = t.partition_point(|&x| x < w.start_s);
+        let i = t.partition_point(|&x| x <= w.start_s);
         let j = t.partition_point(|&x| x <= w.end_s);
         if i >= j {
             return Err(EvalError::NoSolutionInWindow { window: w });

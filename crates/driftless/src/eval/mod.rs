@@ -18,8 +18,8 @@
 //!
 //! Conventions: SI inside (s, m, rad); results carry display units in their field names
 //! (`end_horizontal_m`, `end_heading_deg`). Times are GPS seconds of week, the time
-//! column of the trajectories. A window is the closed interval of
-//! [`OutageWindow`].
+//! column of the trajectories. A window is the half-open interval (start, end]
+//! of [`OutageWindow`]: the fix at the start is used, the one at the end is withheld.
 
 pub mod dynamics;
 pub mod metrics;

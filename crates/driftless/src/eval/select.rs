@@ -169,10 +169,10 @@ impl Timeline {
         })
     }
 
-    /// Epoch index range [i, j) inside the closed interval [a, b].
+    /// Epoch index range [i, j) inside the half-open window (a, b].
     fn range(&self, a: f64, b: f64) -> (usize, usize) {
         (
-            self.time_s.partition_point(|&t| t < a),
+            self.time_s.partition_point(|&t| t <= a),
             self.time_s.partition_point(|&t| t <= b),
         )
     }
@@ -185,7 +185,7 @@ impl Timeline {
         c
     }
 
-    /// `None` when the window [a, b] has reference epochs covering it without a gap
+    /// `None` when the window (a, b] has reference epochs covering it without a gap
     /// longer than `max_gap` (the window's ends count as gap ends), else the reason.
     fn gap_in(&self, a: f64, b: f64, max_gap: f64) -> Option<String> {
         let (i, j) = self.range(a, b);

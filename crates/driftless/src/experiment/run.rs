@@ -30,7 +30,7 @@ use crate::nav::outage::{OutageSpec, OutageWindow};
 use crate::nav::pipeline::{
     GnssOutsideImu, ImuStream, ImuStreamOptions, imu_from_kfgins, read_gnss_file, select_gnss,
 };
-use crate::nav::session::{SessionConfig, initialise_in_motion, prime_gyro_bias};
+use crate::nav::session::{SessionConfig, initialise, prime_gyro_bias};
 use crate::sim::scenario::{ErrorTerms, ImuSpec, OutputSpec, Scenario, TrajectorySpec};
 use crate::sim::sensor_config::SensorConfig;
 use crate::sim::sensor_data::{OutputKind, SensorOutput};
@@ -773,11 +773,10 @@ fn run_case(
     } else {
         None
     };
-    let mut init: InitialState =
-        match initialise_in_motion(&input.imu, input.fixes, &session, primed) {
-            Ok(i) => i,
-            Err(e) => return failed(input.case, format!("initialisation: {e}")),
-        };
+    let mut init: InitialState = match initialise(&input.imu, input.fixes, &session, primed) {
+        Ok(i) => i,
+        Err(e) => return failed(input.case, format!("initialisation: {e}")),
+    };
     let f = &sc.filter;
     if f.initial_gyro_bias_sigma_deg_s.is_some() || f.initial_accel_bias_sigma_m_s2.is_some() {
         let n = &fcfg.imu;
@@ -915,7 +914,7 @@ pub fn vehicle_run(
                 let mut s = session.clone();
                 s.outages.clear();
                 let primed = prime_gyro_bias(&rec.imu, s.static_prime_s.max(1.0));
-                let init = initialise_in_motion(&rec.imu, &rec.fixes, &s, primed)
+                let init = initialise(&rec.imu, &rec.fixes, &s, primed)
                     .map_err(|e| ExperimentError::stage("reference", e))?;
                 let run = run_forward(&rec.imu.epochs, &rec.fixes, init, &s.filter)
                     .map_err(|e| ExperimentError::stage("reference", e))?;

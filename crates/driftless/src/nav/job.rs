@@ -159,9 +159,7 @@ pub fn session_config(
 ) -> Result<SessionConfig, NavJobError> {
     let c = &cfg.config;
     let mut f = FilterConfig::new(noise, c.gnss.lever_arm_m);
-    f.chi2_gate = c
-        .gate_threshold()
-        .map_err(|e| NavJobError::Config(cfg.error(e)))?;
+    f.gate = c.gate().map_err(|e| NavJobError::Config(cfg.error(e)))?;
     f.quality_scale = c.quality_scale();
     f.use_gnss_velocity = c.gnss.use_velocity;
     let a = &c.aids;
@@ -189,6 +187,10 @@ pub fn session_config(
     }
     let mut s = SessionConfig::new(f);
     s.min_speed_m_s = c.align.min_speed_m_s;
+    s.max_heading_sigma_rad = c.align.max_heading_sigma_deg.to_radians();
+    s.align_baseline_s = c.align.baseline_s;
+    s.initial_yaw_rad = c.align.initial_yaw_deg.map(f64::to_radians);
+    s.initial_attitude_rad = c.align.initial_attitude_deg.map(|a| a.map(f64::to_radians));
     s.static_prime_s = c.align.static_s;
     s.converge_s = c.outages.converge_s;
     s.reconverge_s = c.outages.reconverge_s;

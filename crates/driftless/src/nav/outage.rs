@@ -35,22 +35,27 @@
 //!
 //! # Semantics
 //!
-//! A window is the closed interval `[start_s, end_s]`: a GNSS epoch at `start_s` or at
-//! `end_s` is withheld, so the navigation solution at `end_s` is still pure dead reckoning
-//! (the end-of-outage error is measured there) and the first fix used again lies strictly
-//! after `end_s`. See [`OutageWindow::contains`].
+//! A window is the half-open interval `(start_s, end_s]`: a GNSS epoch t is withheld
+//! when `start_s < t ≤ end_s` — the fixes a user deletes from a file to simulate an
+//! outage from `start_s` to `end_s`. The fix at `start_s` is still used (the filter is
+//! GNSS-aided up to the start), the fix at `end_s` is not, so the navigation solution at
+//! `end_s` is pure dead reckoning over the whole length `end_s − start_s` and the first
+//! fix used again lies strictly after `end_s`. The filter
+//! ([`crate::nav::filter::FilterConfig::outages_s`]), [`is_masked`], the session's
+//! evaluation and `crate::eval` all use this convention. See [`OutageWindow::contains`].
 
 use std::fmt;
 use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-/// One outage in absolute GPS time (seconds of week of the GNSS data), closed interval.
+/// One outage in absolute GPS time (seconds of week of the GNSS data), half-open
+/// interval (start, end].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct OutageWindow {
-    /// First withheld instant, GPS s of week.
+    /// Start, GPS s of week: the last instant still aided (a fix exactly here is used).
     pub start_s: f64,
-    /// Last withheld instant, GPS s of week (> `start_s`).
+    /// End, GPS s of week (> `start_s`): the last withheld instant.
     pub end_s: f64,
 }
 
@@ -59,15 +64,16 @@ impl OutageWindow {
     pub fn duration_s(&self) -> f64 {
         self.end_s - self.start_s
     }
-    /// True when a GNSS epoch at `time_s` falls inside the window (ends included).
+    /// True when a GNSS epoch at `time_s` falls inside the window:
+    /// `start_s < time_s ≤ end_s`.
     pub fn contains(&self, time_s: f64) -> bool {
-        time_s >= self.start_s && time_s <= self.end_s
+        time_s > self.start_s && time_s <= self.end_s
     }
 }
 
 impl fmt::Display for OutageWindow {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "[{} s, {} s]", self.start_s, self.end_s)
+        write!(f, "({} s, {} s]", self.start_s, self.end_s)
     }
 }
 
@@ -448,7 +454,8 @@ pub fn resolve(spec: &OutageSpec, span: TimeSpan) -> Result<Vec<OutageWindow>, O
     Ok(windows)
 }
 
-/// True when `time_s` lies in any of `windows` (closed intervals).
+/// True when `time_s` lies in any of `windows` (half-open (start, end], see
+/// [`OutageWindow::contains`]).
 pub fn is_masked(windows: &[OutageWindow], time_s: f64) -> bool {
     windows.iter().any(|w| w.contains(time_s))
 }

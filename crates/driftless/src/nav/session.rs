@@ -1,31 +1,55 @@
-//! One navigation job on recorded data: initialise in motion, run the forward filter with
-//! GNSS outages, and evaluate against the reference fixes.
+//! One navigation job on recorded data: initialise (at rest or in motion), run the
+//! forward filter with GNSS outages, and evaluate against the reference fixes.
 //!
-//! * **Initialisation** (issue 3 deliverable 4, in-motion variant): the gyro biases are
-//!   primed from the mean angular rate of a static stretch at the start of the log (when
-//!   the IMU is static there — |f̄| ≈ g and a small rate spread; the Earth rate, ≤ 15 deg/h,
-//!   is left in the estimate and absorbed by the filter). The filter starts at the first
-//!   GNSS epoch with a velocity and a horizontal speed above `min_speed_m_s`: heading from
-//!   the course over ground, pitch from the climb angle, roll 0 (a land vehicle without
-//!   sideslip, IMU axes already rotated into the vehicle frame), position from the fix
-//!   moved from the antenna to the IMU by the lever arm, velocity from GNSS — or, for
-//!   position-only GNSS, the central difference of the neighbouring fixes (σ 0.3 m/s).
+//! * **Initialisation** ([`initialise`]): the gyro biases are primed from the mean
+//!   angular rate of a static stretch at the start of the log when the IMU is static
+//!   there (|f̄| ≈ g and a small rate spread; the Earth rate, ≤ 15 deg/h, is left in the
+//!   estimate and absorbed by the filter). The filter starts at a GNSS fix inside the IMU
+//!   span, outside the outage windows, with an accepted quality flag and with a velocity:
+//!   * **yaw**: given ([`SessionConfig::initial_yaw_rad`] or the third component of
+//!     [`SessionConfig::initial_attitude_rad`]; the filter then starts at the first such
+//!     fix whatever the speed), else the course over ground atan2(v_E, v_N) at the first
+//!     fix with a horizontal speed above [`SessionConfig::min_speed_m_s`] and a course σ
+//!     at most [`SessionConfig::max_heading_sigma_rad`] (below);
+//!   * **roll, pitch**: given (`initial_attitude_rad`), else levelled from the
+//!     accelerometer over the static start ([`super::filter::level_static`]) and carried
+//!     to the start epoch by integrating the bias-compensated gyro (the tilt is yaw-free:
+//!     the down vector in the body frame rotates with the body alone; Earth rate and
+//!     transport rate, < 0.005 deg/s, neglected), else the land-vehicle guess: pitch the
+//!     climb angle atan2(−v_D, v_H) (0 below `min_speed_m_s`), roll 0;
+//!   * **velocity**: the GNSS velocity, or for position-only GNSS the chord of the fixes
+//!     around the start fix over [`SessionConfig::align_baseline_s`] (the first and last
+//!     fix within ±baseline/2; for a path of constant curvature the chord is parallel to
+//!     the tangent at the middle fix, so the course is unbiased in a steady turn);
+//!   * **position**: the fix moved from the antenna to the IMU by the lever arm.
+//!
+//!   Initial σ, consistent with how each value was obtained: given angles
+//!   [`SessionConfig::given_attitude_sigma_rad`]; levelled roll/pitch
+//!   √(σ_level² + (σ_ω Δt)²), σ_level = σ_f/g from [`super::filter::level_static`],
+//!   σ_ω = Ω_ie + ARW/√T_static the residual rate after priming, Δt the time from the
+//!   static window's end to the start; the vehicle guess 2°; the course
+//!   σ_ψ = √((σ_vH/v_H)² + (δ/2)²) with σ_vH the horizontal velocity σ (GNSS velocity σ,
+//!   else √(σ_a² + σ_b²)/(t_b − t_a) of the chord's two fixes, σ after the floor and
+//!   quality scaling) and δ the angle between the chords of the two halves of the
+//!   baseline (turning and antenna sway; conservative in a steady turn), floored at 1°.
+//!   Example: a 1.2 m/s walk with 4-Hz fixes of 5 cm σ, 2-s baseline, straight:
+//!   σ_vH = 0.035 m/s, σ_ψ ≈ 1.7°; with 10-cm σ 3.4°.
 //! * **Evaluation**: the reference is the GNSS fixes themselves (on `drive_0708` an RTK
 //!   solution, cm level). The full-GNSS accuracy is the one-step prediction error at each
 //!   accepted fix — the horizontal innovation, i.e. the filter's antenna position *before*
 //!   it sees the fix vs the fix — which is stricter than comparing the updated solution.
-//!   For each outage window, the end-of-outage error is the horizontal innovation of the
-//!   first fix after the window, and the maximum error inside it compares the antenna
-//!   position at every IMU epoch with the reference interpolated linearly between fixes.
+//!   Per outage window (s, e] see [`OutageResult`].
 
 use super::attitude::Euler;
+use super::attitude::Quat;
 use super::earth::{meridian_radius_m, ned_offset_m, prime_vertical_radius_m};
 use super::filter::NavError;
+use super::filter::align::{AlignConfig, level_static};
 use super::filter::eskf::UpdateKind;
 use super::filter::model::FilterConfig;
 use super::filter::run::{ForwardRun, InitialState, run_forward};
 use super::filter::state::SensorErrors;
-use super::mechanization::NavState;
+use super::mechanization::{ImuIncrement, NavState};
 use super::outage::OutageWindow;
 use super::pipeline::ImuStream;
 use crate::io::nav::GnssFixes;
@@ -38,8 +62,23 @@ pub struct SessionConfig {
     pub filter: FilterConfig,
     /// GNSS outage windows, absolute GNSS times.
     pub outages: Vec<OutageWindow>,
-    /// Horizontal speed needed to take the heading from GNSS velocity, m/s.
+    /// Horizontal speed needed to take the heading from the GNSS course, m/s. Default
+    /// 0.5: a slow walk or a slow robot still aligns, and the course σ (module docs:
+    /// σ_vH/v_H plus turning) tells the filter how good the course is; a fix whose
+    /// course σ exceeds `max_heading_sigma_rad` is passed over for a later one.
     pub min_speed_m_s: f64,
+    /// Largest heading σ accepted from the GNSS course, rad. Default 10°.
+    pub max_heading_sigma_rad: f64,
+    /// Baseline of the fixes whose chord gives the velocity for position-only GNSS, s.
+    /// Default 2 (at 4 Hz the chord spans 9 fixes; at 1 Hz 3).
+    pub align_baseline_s: f64,
+    /// Given initial yaw, rad: the filter starts at the first usable fix regardless of
+    /// speed. Ignored when `initial_attitude_rad` is set.
+    pub initial_yaw_rad: Option<f64>,
+    /// Given initial roll, pitch, yaw, rad (body FRD to NED, z-y-x Euler angles).
+    pub initial_attitude_rad: Option<[f64; 3]>,
+    /// σ of given roll, pitch, yaw, rad. Default (1°, 1°, 5°).
+    pub given_attitude_sigma_rad: [f64; 3],
     /// Length of the static stretch at the start used to prime the gyro biases, s (0 = off).
     pub static_prime_s: f64,
     /// Time after the start excluded from the full-GNSS accuracy figure, s.
@@ -64,7 +103,12 @@ impl SessionConfig {
         SessionConfig {
             filter,
             outages: Vec::new(),
-            min_speed_m_s: 3.0,
+            min_speed_m_s: 0.5,
+            max_heading_sigma_rad: 10f64.to_radians(),
+            align_baseline_s: 2.0,
+            initial_yaw_rad: None,
+            initial_attitude_rad: None,
+            given_attitude_sigma_rad: [1f64.to_radians(), 1f64.to_radians(), 5f64.to_radians()],
             static_prime_s: 10.0,
             converge_s: 60.0,
             reconverge_s: 30.0,
@@ -75,16 +119,25 @@ impl SessionConfig {
     }
 }
 
-/// Errors of one outage window.
+/// Errors of one outage window (s, e] (fixes at s < t ≤ e withheld,
+/// [`OutageWindow::contains`]).
+///
+/// * **End-of-outage error**: the innovation of the first position fix after the window
+///   (t > e, within 2 s of e) — the filter's predicted antenna position before that fix
+///   minus the fix, i.e. the error after dead reckoning from the last fix used (at or
+///   before s) to that fix. Reported whether the gate accepted the fix or not.
+/// * **Maximum error inside**: the largest horizontal distance between the antenna
+///   position of the solution and the reference (the fixes interpolated linearly, gaps
+///   ≤ 2 s) over the IMU epochs with s < t ≤ e.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OutageResult {
     /// The window.
     pub window: OutageWindow,
-    /// Horizontal error at the end of the outage (innovation of the first fix after it), m.
+    /// Horizontal end-of-outage error, m.
     pub end_horizontal_m: Option<f64>,
     /// Largest horizontal error inside the window, m.
     pub max_horizontal_m: f64,
-    /// Vertical error at the end of the outage, m.
+    /// Vertical end-of-outage error, m.
     pub end_vertical_m: Option<f64>,
 }
 
@@ -134,7 +187,7 @@ pub fn run_session(
         }
         None => gnss,
     };
-    let init = initialise_in_motion(imu, used, cfg, primed)?;
+    let init = initialise(imu, used, cfg, primed)?;
     let mut fcfg = cfg.filter.clone();
     fcfg.outages_s = cfg.outages.iter().map(|w| (w.start_s, w.end_s)).collect();
     let run = run_forward(&imu.epochs, used, init, &fcfg)?;
@@ -149,7 +202,7 @@ pub fn run_session(
                 .iter()
                 .map(|w| (w.start_s, w.end_s))
                 .chain(data_gaps.iter().copied())
-                .any(|(a, b)| t >= a && t <= b + cfg.reconverge_s)
+                .any(|(a, b)| t > a && t <= b + cfg.reconverge_s)
     };
     let mut sum2 = 0.0;
     let mut count = 0usize;
@@ -197,36 +250,26 @@ pub fn run_session(
     })
 }
 
-/// Mean angular rate over the first `seconds` of the log when it is static there:
-/// |mean f| within 0.3 m/s² of 9.8 and every 1-s mean rate within 0.02 rad/s of the total
-/// mean. `None` otherwise.
-pub fn prime_gyro_bias(imu: &ImuStream, seconds: f64) -> Option<Vec3> {
+/// The first `seconds` of the log when the IMU is static there: |mean f| within
+/// 0.3 m/s² of 9.8 and every 1-s mean rate within 0.02 rad/s of the total mean; at least
+/// 10 epochs covering half of `seconds`. `None` otherwise.
+pub fn static_start(imu: &ImuStream, seconds: f64) -> Option<&[ImuIncrement]> {
     let first = imu.epochs.first()?;
     let t_end = first.time_s + seconds;
-    let win: Vec<_> = imu
-        .epochs
-        .iter()
-        .take_while(|e| e.time_s <= t_end)
-        .collect();
+    let n = imu.epochs.partition_point(|e| e.time_s <= t_end);
+    let win = &imu.epochs[..n];
     let total_t: f64 = win.iter().map(|e| e.dt_s).sum();
     if win.len() < 10 || total_t < 0.5 * seconds {
         return None;
     }
-    let mut dth = [0.0; 3];
-    let mut dv = [0.0; 3];
-    for e in &win {
-        dth = add(dth, e.dtheta_rad);
-        dv = add(dv, e.dvel_m_s);
-    }
-    let w = scale(dth, 1.0 / total_t);
-    let f = scale(dv, 1.0 / total_t);
+    let (w, f) = mean_rate_force(win);
     if (norm(f) - 9.8).abs() > 0.3 {
         return None;
     }
     // Rate steadiness: 1-s block means stay near the overall mean.
     let mut block = [0.0; 3];
     let mut bt = 0.0;
-    for e in &win {
+    for e in win {
         block = add(block, e.dtheta_rad);
         bt += e.dt_s;
         if bt >= 1.0 {
@@ -238,29 +281,63 @@ pub fn prime_gyro_bias(imu: &ImuStream, seconds: f64) -> Option<Vec3> {
             bt = 0.0;
         }
     }
-    Some(w)
+    Some(win)
 }
 
-/// Initial state at the first GNSS epoch with velocity and enough speed (see module docs).
-pub fn initialise_in_motion(
+/// Mean angular rate and specific force of a block of increments.
+fn mean_rate_force(win: &[ImuIncrement]) -> (Vec3, Vec3) {
+    let total_t: f64 = win.iter().map(|e| e.dt_s).sum();
+    let mut dth = [0.0; 3];
+    let mut dv = [0.0; 3];
+    for e in win {
+        dth = add(dth, e.dtheta_rad);
+        dv = add(dv, e.dvel_m_s);
+    }
+    (scale(dth, 1.0 / total_t), scale(dv, 1.0 / total_t))
+}
+
+/// Mean angular rate over the first `seconds` of the log when it is static there
+/// ([`static_start`]). `None` otherwise.
+pub fn prime_gyro_bias(imu: &ImuStream, seconds: f64) -> Option<Vec3> {
+    static_start(imu, seconds).map(|w| mean_rate_force(w).0)
+}
+
+/// Velocity of a candidate start fix and the σ that go with it (module docs).
+struct StartVelocity {
+    /// NED velocity, m/s.
+    v: Vec3,
+    /// σ of one horizontal velocity component, m/s.
+    sigma_h_m_s: f64,
+    /// σ of the vertical component, m/s.
+    sigma_v_m_s: f64,
+    /// Angle between the chords of the two halves of the baseline, rad (0 for GNSS
+    /// velocity).
+    turn_rad: f64,
+}
+
+impl StartVelocity {
+    /// Course σ σ_ψ = √((σ_vH/v_H)² + (δ/2)²), floored at 1°.
+    fn heading_sigma_rad(&self) -> f64 {
+        let vh = self.v[0].hypot(self.v[1]);
+        (self.sigma_h_m_s / vh)
+            .hypot(0.5 * self.turn_rad)
+            .max(1f64.to_radians())
+    }
+}
+
+/// Initial state at the first usable GNSS fix (module docs: given or levelled attitude,
+/// course over ground at speed).
+///
+/// Errors: no usable fix (names the speed reached and what to change), or a given
+/// attitude that is not finite.
+pub fn initialise(
     imu: &ImuStream,
     gnss: &GnssFixes,
     cfg: &SessionConfig,
     primed_gyro_bias: Option<Vec3>,
 ) -> Result<InitialState, NavError> {
-    // GNSS velocity, or the central difference of the neighbouring fixes (≤ 2.5 s apart
-    // on each side) for position-only GNSS.
-    let derived: Vec<Option<Vec3>>;
-    let vel: Vec<Option<Vec3>> = match gnss.vel_ned_m_s.as_ref() {
-        Some(v) => v.iter().map(|&v| Some(v)).collect(),
-        None => {
-            derived = (0..gnss.time_s.len())
-                .map(|i| velocity_from_fixes(gnss, i, 2.5))
-                .collect();
-            derived
-        }
-    };
-    let vel_sigma = if gnss.vel_ned_m_s.is_some() { 0.1 } else { 0.3 };
+    let fcfg = &cfg.filter;
+    let n = gnss.time_s.len();
     let imu_start = imu
         .epochs
         .first()
@@ -271,43 +348,144 @@ pub fn initialise_in_motion(
         .last()
         .map(|e| e.time_s)
         .unwrap_or(f64::NEG_INFINITY);
-    let in_outage = |t: f64| cfg.outages.iter().any(|w| t >= w.start_s && t <= w.end_s);
-    let i = (0..gnss.time_s.len())
-        .find(|&i| {
-            let t = gnss.time_s[i];
-            vel[i].is_some_and(|v| {
-                t > imu_start + 0.05
-                    && t < imu_end - 1.0
-                    && !in_outage(t)
-                    && v[0].hypot(v[1]) > cfg.min_speed_m_s
-            })
-        })
-        .ok_or_else(|| {
-            NavError::Config(format!(
-                "no GNSS epoch inside the IMU span with a horizontal speed above {} m/s to \
-                 initialise the heading",
-                cfg.min_speed_m_s
-            ))
-        })?;
-    let Some(v) = vel[i] else {
-        return Err(NavError::Config(
-            "no GNSS velocity at the chosen epoch".into(),
-        ));
+    let in_outage = |t: f64| cfg.outages.iter().any(|w| w.contains(t));
+    let quality_ok =
+        |i: usize| fcfg.accept_quality.is_empty() || fcfg.accept_quality.contains(&gnss.quality[i]);
+    // Usable for the chord: a fix the filter would use.
+    let fix_ok = |i: usize| !in_outage(gnss.time_s[i]) && quality_ok(i);
+    // Horizontal σ of fix i after the quality scaling, m.
+    let sigma_fix = |i: usize| {
+        let k = fcfg.quality_scale.factor(gnss.quality[i]);
+        let s = gnss.sigma_ned_m[i];
+        (s[0].max(s[1]) * k, s[2] * k)
     };
+    let half = 0.5 * cfg.align_baseline_s;
+    let velocity = |i: usize| -> Option<StartVelocity> {
+        if let Some(v) = gnss.vel_ned_m_s.as_ref() {
+            let (sh, sv) = match gnss.sigma_vel_ned_m_s.as_ref() {
+                Some(s) => (s[i][0].max(s[i][1]), s[i][2]),
+                None => (0.1, 0.1),
+            };
+            let k = fcfg.quality_scale.factor(gnss.quality[i]);
+            return Some(StartVelocity {
+                v: v[i],
+                sigma_h_m_s: sh * k,
+                sigma_v_m_s: sv * k,
+                turn_rad: 0.0,
+            });
+        }
+        let t = gnss.time_s[i];
+        let a = gnss.time_s.partition_point(|&x| x < t - half - 1e-9);
+        let b = gnss.time_s.partition_point(|&x| x <= t + half + 1e-9) - 1;
+        if a >= i || b <= i || b >= n || !fix_ok(a) || !fix_ok(b) {
+            return None;
+        }
+        let (ta, tb) = (gnss.time_s[a], gnss.time_s[b]);
+        if cfg.outages.iter().any(|w| w.end_s > ta && w.start_s < tb) {
+            return None;
+        }
+        let llh = |j: usize| (gnss.lat_rad[j], gnss.lon_rad[j], gnss.height_m[j]);
+        let d = ned_offset_m(llh(a), llh(b));
+        let d1 = ned_offset_m(llh(a), llh(i));
+        let d2 = ned_offset_m(llh(i), llh(b));
+        let v = scale(d, 1.0 / (tb - ta));
+        let mut turn = d2[1].atan2(d2[0]) - d1[1].atan2(d1[0]);
+        turn = (turn + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI)
+            - std::f64::consts::PI;
+        let ((ha, va), (hb, vb)) = (sigma_fix(a), sigma_fix(b));
+        let ok = v.iter().all(|x| x.is_finite()) && turn.is_finite();
+        ok.then(|| StartVelocity {
+            v,
+            sigma_h_m_s: ha.hypot(hb) / (tb - ta),
+            sigma_v_m_s: va.hypot(vb) / (tb - ta),
+            turn_rad: turn.abs(),
+        })
+    };
+    let usable = |i: usize| {
+        let t = gnss.time_s[i];
+        t > imu_start + 0.05 && t < imu_end - 1.0 && fix_ok(i)
+    };
+    let given_yaw = cfg
+        .initial_attitude_rad
+        .map(|a| a[2])
+        .or(cfg.initial_yaw_rad);
+    if let Some(a) = cfg.initial_attitude_rad
+        && !a.iter().all(|v| v.is_finite())
+    {
+        return Err(NavError::Config(format!(
+            "initial attitude {a:?} rad is not finite"
+        )));
+    }
+    if given_yaw.is_some_and(|y| !y.is_finite()) {
+        return Err(NavError::Config("initial yaw is not finite".into()));
+    }
+    let mut fastest: Option<(f64, f64)> = None;
+    let start = (0..n).filter(|&i| usable(i)).find_map(|i| {
+        let sv = velocity(i)?;
+        if given_yaw.is_some() {
+            return Some((i, sv));
+        }
+        let vh = sv.v[0].hypot(sv.v[1]);
+        if fastest.is_none_or(|(v, _)| vh > v) {
+            fastest = Some((vh, gnss.time_s[i]));
+        }
+        (vh > cfg.min_speed_m_s && sv.heading_sigma_rad() <= cfg.max_heading_sigma_rad)
+            .then_some((i, sv))
+    });
+    let Some((i, sv)) = start else {
+        let reached = match fastest {
+            Some((v, t)) => format!("the fastest usable fix moves at {v:.2} m/s (t = {t} s)"),
+            None => "no fix inside the IMU span has a velocity (GNSS velocity, or fixes on \
+                     both sides within the alignment baseline)"
+                .to_string(),
+        };
+        return Err(NavError::Alignment(format!(
+            "no GNSS fix to initialise the heading from: it needs a horizontal speed above \
+             {} m/s with a course σ ≤ {:.1}°, and {reached}; pass the initial heading \
+             (--initial-yaw-deg) or lower the alignment speed (--align-min-speed)",
+            cfg.min_speed_m_s,
+            cfg.max_heading_sigma_rad.to_degrees()
+        )));
+    };
+    let v = sv.v;
+    let t_start = gnss.time_s[i];
     let horiz = v[0].hypot(v[1]);
+    let (yaw, sigma_yaw) = match given_yaw {
+        Some(y) => (y, cfg.given_attitude_sigma_rad[2]),
+        None => (v[1].atan2(v[0]), sv.heading_sigma_rad()),
+    };
+    let (roll, pitch, sigma_roll, sigma_pitch) = match cfg.initial_attitude_rad {
+        Some(a) => (
+            a[0],
+            a[1],
+            cfg.given_attitude_sigma_rad[0],
+            cfg.given_attitude_sigma_rad[1],
+        ),
+        None => match levelled_tilt(imu, cfg, primed_gyro_bias, gnss, t_start) {
+            Some((r, p, s)) => (r, p, s, s),
+            None => {
+                let pitch = if horiz > cfg.min_speed_m_s {
+                    (-v[2]).atan2(horiz)
+                } else {
+                    0.0
+                };
+                (0.0, pitch, 2f64.to_radians(), 2f64.to_radians())
+            }
+        },
+    };
     let att = Euler {
-        roll_rad: 0.0,
-        pitch_rad: (-v[2]).atan2(horiz),
-        yaw_rad: v[1].atan2(v[0]),
+        roll_rad: roll,
+        pitch_rad: pitch,
+        yaw_rad: yaw,
     };
     let q_bn = att.to_quat();
     // Antenna → IMU: r_imu = r_ant − C_bn·l (NED metres, converted with the local radii).
-    let l_n = q_bn.rotate(cfg.filter.lever_arm_b_m);
+    let l_n = q_bn.rotate(fcfg.lever_arm_b_m);
     let (lat_a, lon_a, h_a) = (gnss.lat_rad[i], gnss.lon_rad[i], gnss.height_m[i]);
     let rm = meridian_radius_m(lat_a) + h_a;
     let rn = prime_vertical_radius_m(lat_a) + h_a;
     let nav = NavState {
-        time_s: gnss.time_s[i],
+        time_s: t_start,
         lat_rad: lat_a - l_n[0] / rm,
         lon_rad: lon_a - l_n[1] / (rn * lat_a.cos()),
         height_m: h_a + l_n[2],
@@ -318,7 +496,7 @@ pub fn initialise_in_motion(
     let mut sigma_sensors = cfg.initial_sensor_sigma;
     if let Some(b) = primed_gyro_bias {
         sensors.gyro_bias_rad_s = b;
-        let n = &cfg.filter.imu;
+        let n = &fcfg.imu;
         // Primed from ≥ a few seconds of static data: the residual is the Earth rate plus
         // the short-term drift; keep the other sensor states at their initial σ.
         let mut s = cfg.initial_sensor_sigma.unwrap_or_else(|| {
@@ -336,15 +514,76 @@ pub fn initialise_in_motion(
         }
         sigma_sensors = Some(s);
     }
-    let sp = gnss.sigma_ned_m[i];
+    let (sh, sv_pos) = sigma_fix(i);
+    // The chord is the mean velocity over the baseline: allow 0.3 m/s for the change of
+    // velocity over it (and GNSS velocity 0.1 m/s at least).
+    let floor_v = if gnss.vel_ned_m_s.is_some() { 0.1 } else { 0.3 };
     Ok(InitialState {
         nav,
         sensors,
-        sigma_pos_ned_m: [sp[0].max(0.05), sp[1].max(0.05), sp[2].max(0.1)],
-        sigma_vel_ned_m_s: [vel_sigma; 3],
-        sigma_att_rad: [2f64.to_radians(), 2f64.to_radians(), 3f64.to_radians()],
+        sigma_pos_ned_m: [sh.max(0.05), sh.max(0.05), sv_pos.max(0.1)],
+        sigma_vel_ned_m_s: [
+            sv.sigma_h_m_s.max(floor_v),
+            sv.sigma_h_m_s.max(floor_v),
+            sv.sigma_v_m_s.max(floor_v),
+        ],
+        sigma_att_rad: [sigma_roll, sigma_pitch, sigma_yaw],
         sigma_sensors,
     })
+}
+
+/// Roll, pitch (rad) at `t_start` and their σ from levelling the static start of the log
+/// and carrying the tilt forward with the bias-compensated gyro (module docs); `None`
+/// when the log does not start static or levelling refuses.
+fn levelled_tilt(
+    imu: &ImuStream,
+    cfg: &SessionConfig,
+    primed_gyro_bias: Option<Vec3>,
+    gnss: &GnssFixes,
+    t_start: f64,
+) -> Option<(f64, f64, f64)> {
+    if cfg.static_prime_s <= 0.0 {
+        return None;
+    }
+    let win = static_start(imu, cfg.static_prime_s)?;
+    let n = &cfg.filter.imu;
+    let acfg = AlignConfig::new(
+        n.gyro_arw_rad_sqrt_s,
+        n.gyro_bias.sigma,
+        n.accel_vrw_m_s_sqrt_s,
+        n.accel_bias.sigma,
+    );
+    let (lat, h) = (*gnss.lat_rad.first()?, *gnss.height_m.first()?);
+    let (roll0, pitch0, sigma_level) = level_static(win, lat, h, &acfg).ok()?;
+    let t_static = win.last()?.time_s;
+    let t_len: f64 = win.iter().map(|e| e.dt_s).sum();
+    // Down vector in the body frame at the end of the static window: C_nb (0, 0, 1).
+    let c_bn = Euler {
+        roll_rad: roll0,
+        pitch_rad: pitch0,
+        yaw_rad: 0.0,
+    }
+    .to_dcm();
+    let d0: Vec3 = [c_bn.0[2][0], c_bn.0[2][1], c_bn.0[2][2]];
+    // q from the body at t to the body at the end of the static window.
+    let b = primed_gyro_bias.unwrap_or([0.0; 3]);
+    let mut q = Quat::from_rotation_vector([0.0; 3]);
+    let mut dt_total = 0.0;
+    for e in imu
+        .epochs
+        .iter()
+        .skip_while(|e| e.time_s <= t_static)
+        .take_while(|e| e.time_s <= t_start)
+    {
+        let dth: Vec3 = std::array::from_fn(|k| e.dtheta_rad[k] - b[k] * e.dt_s);
+        q = q.mul(&Quat::from_rotation_vector(dth)).normalized();
+        dt_total += e.dt_s;
+    }
+    let d = q.conj().rotate(d0);
+    let roll = d[1].atan2(d[2]);
+    let pitch = (-d[0]).atan2(d[1].hypot(d[2]));
+    let sigma_w = super::earth::OMEGA_IE + n.gyro_arw_rad_sqrt_s / t_len.sqrt();
+    Some((roll, pitch, sigma_level.hypot(sigma_w * dt_total)))
 }
 
 /// Gaps in a GNSS time column longer than three median intervals, as (last fix before,
@@ -361,26 +600,6 @@ fn gnss_data_gaps(time_s: &[f64]) -> Vec<(f64, f64)> {
         .filter(|w| w[1] - w[0] > limit)
         .map(|w| (w[0], w[1]))
         .collect()
-}
-
-/// NED velocity at fix `i` from the central difference of fixes `i − 1` and `i + 1`
-/// (second-order accurate in the spacing when the fixes are evenly spaced), when both
-/// neighbours exist within `max_gap_s`.
-fn velocity_from_fixes(gnss: &GnssFixes, i: usize, max_gap_s: f64) -> Option<Vec3> {
-    let (a, b) = (i.checked_sub(1)?, i + 1);
-    if b >= gnss.time_s.len() {
-        return None;
-    }
-    let (ta, t, tb) = (gnss.time_s[a], gnss.time_s[i], gnss.time_s[b]);
-    if !(t - ta > 0.0 && t - ta <= max_gap_s && tb - t > 0.0 && tb - t <= max_gap_s) {
-        return None;
-    }
-    let d = ned_offset_m(
-        (gnss.lat_rad[a], gnss.lon_rad[a], gnss.height_m[a]),
-        (gnss.lat_rad[b], gnss.lon_rad[b], gnss.height_m[b]),
-    );
-    let v = scale(d, 1.0 / (tb - ta));
-    v.iter().all(|x| x.is_finite()).then_some(v)
 }
 
 /// Antenna position of a record, (lat, lon, h).
@@ -412,10 +631,7 @@ fn reference_at(g: &GnssFixes, t: f64) -> Option<(f64, f64, f64)> {
 
 /// Horizontal error of the last state inside the window against the reference.
 fn end_error(states: &[&NavState], g: &GnssFixes, w: OutageWindow, lever: Vec3) -> Option<f64> {
-    let last = states
-        .iter()
-        .rev()
-        .find(|n| n.time_s <= w.end_s && n.time_s >= w.start_s)?;
+    let last = states.iter().rev().find(|n| w.contains(n.time_s))?;
     let r = reference_at(g, last.time_s)?;
     let d = ned_offset_m(r, antenna(last, lever));
     Some(d[0].hypot(d[1]))
@@ -431,7 +647,7 @@ fn outage_errors(
     let mut max_h = 0.0f64;
     for n in states {
         let t = n.time_s;
-        if t < w.start_s || t > w.end_s {
+        if !w.contains(t) {
             continue;
         }
         if let Some(r) = reference_at(g, t) {

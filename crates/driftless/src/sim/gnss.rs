@@ -76,7 +76,8 @@ pub struct GnssSimConfig {
     /// Windows of degraded solutions (RTK float …), ordered and not overlapping.
     #[serde(default)]
     pub degraded_windows: Vec<DegradedWindow>,
-    /// Windows (start, end) without fixes, s.
+    /// Windows (start, end] without fixes, s: no fix at start < t ≤ end (the convention
+    /// of [`crate::nav::outage::OutageWindow`]).
     #[serde(default)]
     pub outages_s: Vec<(f64, f64)>,
     /// Added to every time stamp on output (e.g. GPS seconds of week at t = 0), s.
@@ -315,7 +316,7 @@ pub fn simulate_gnss<T: Trajectory + ?Sized>(
             Some(s) => std::array::from_fn(|a| s[a] * vel_rng.normal()),
             None => [0.0; 3],
         };
-        if cfg.outages_s.iter().any(|&(a, b)| t >= a && t <= b) {
+        if cfg.outages_s.iter().any(|&(a, b)| t > a && t <= b) {
             continue;
         }
         let p = traj.point(t);
@@ -379,8 +380,9 @@ mod tests {
         cfg.outages_s = vec![(10.0, 12.0)];
         cfg.time_offset_s = 1000.0;
         let g = simulate_gnss(&traj, &cfg, 1).unwrap();
-        // 61 epochs from 0 to 30 s at 2 Hz, minus 10, 10.5, …, 12 (5 of them)
-        assert_eq!(g.len(), 56);
+        // 61 epochs from 0 to 30 s at 2 Hz, minus 10.5, 11, …, 12 (4 of them: the window
+        // (10, 12] keeps the fix at 10 s)
+        assert_eq!(g.len(), 57);
         assert_eq!(g.time_s[0], 1000.0);
         for i in 0..g.len() {
             let t = g.time_s[i] - 1000.0;

@@ -1,7 +1,7 @@
 //! Simulation shared by the filter and smoother tests: ideal increments of an analytic
 //! figure-of-eight drive (`sim::ideal_imu`) plus injected biases and white noise, GNSS at
 //! the antenna (lever arm) at 1 Hz with 2 cm σ. Included with `#[path]` by
-//! `tests/nav_filter.rs` and `tests/nav_smoother.rs`.
+//! `tests/nav_filter.rs`, `tests/nav_smoother.rs` and (for [`perturbed_start`]) `tests/nav_gating.rs`.
 #![allow(dead_code)] // each test file uses a different subset
 
 use driftless::io::nav::{GnssFixes, quality};
@@ -67,17 +67,27 @@ pub fn drive() -> impl Trajectory {
 
 /// Raw IMU: ideal increments over (−DT, duration] plus biases and white noise.
 pub fn simulate_imu<T: Trajectory>(traj: &T, duration_s: f64, seed: u64) -> Vec<ImuIncrement> {
+    simulate_imu_with(traj, duration_s, seed, [GYRO_BIAS, ACCEL_BIAS], [ARW, VRW])
+}
+
+/// [`simulate_imu`] with other constant biases `[gyro rad/s, accel m/s²]` and white
+/// noise `[ARW rad/√s, VRW m/s/√s]`.
+pub fn simulate_imu_with<T: Trajectory>(
+    traj: &T,
+    duration_s: f64,
+    seed: u64,
+    bias: [Vec3; 2],
+    white: [f64; 2],
+) -> Vec<ImuIncrement> {
     let n = (duration_s / DT).round() as usize + 1;
     let mut rng = Rng::seed_from_u64(seed);
-    let (sg, sa) = (ARW * DT.sqrt(), VRW * DT.sqrt());
+    let (sg, sa) = (white[0] * DT.sqrt(), white[1] * DT.sqrt());
     ideal_increments(traj, 0.0, DT, n)
         .map(|i| ImuIncrement {
             dtheta_rad: std::array::from_fn(|k| {
-                i.dtheta_rad[k] + GYRO_BIAS[k] * DT + sg * rng.normal()
+                i.dtheta_rad[k] + bias[0][k] * DT + sg * rng.normal()
             }),
-            dvel_m_s: std::array::from_fn(|k| {
-                i.dvel_m_s[k] + ACCEL_BIAS[k] * DT + sa * rng.normal()
-            }),
+            dvel_m_s: std::array::from_fn(|k| i.dvel_m_s[k] + bias[1][k] * DT + sa * rng.normal()),
             ..i
         })
         .collect()
@@ -139,19 +149,30 @@ pub fn config() -> FilterConfig {
 
 /// Initial state: truth at t = 0 perturbed by 0.3 m, 0.1 m/s, (0.5°, −0.5°, 3°).
 pub fn initial<T: Trajectory>(traj: &T) -> InitialState {
+    perturbed_start(traj, 0.1, [0.5 * DEG, -0.5 * DEG, 3.0 * DEG], 0.5)
+}
+
+/// Truth at t = 0 moved 0.3 m north, `dv_east_m_s` east in velocity and rotated by the
+/// attitude error `att_err_rad` (phi-angle); σ 1 m, `sigma_vel_m_s`, (1°, 1°, 5°).
+pub fn perturbed_start<T: Trajectory>(
+    traj: &T,
+    dv_east_m_s: f64,
+    att_err_rad: Vec3,
+    sigma_vel_m_s: f64,
+) -> InitialState {
     let p = traj.point(0.0);
     let mut nav = p.nav_state(0.0);
     let rm = earth::meridian_radius_m(nav.lat_rad) + nav.height_m;
     nav.lat_rad += 0.3 / rm;
-    nav.vel_ned_m_s[1] += 0.1;
-    nav.q_bn = Quat::from_rotation_vector([0.5 * DEG, -0.5 * DEG, 3.0 * DEG])
+    nav.vel_ned_m_s[1] += dv_east_m_s;
+    nav.q_bn = Quat::from_rotation_vector(att_err_rad)
         .mul(&nav.q_bn)
         .normalized();
     InitialState {
         nav,
         sensors: SensorErrors::default(),
         sigma_pos_ned_m: [1.0; 3],
-        sigma_vel_ned_m_s: [0.5; 3],
+        sigma_vel_ned_m_s: [sigma_vel_m_s; 3],
         sigma_att_rad: [1.0 * DEG, 1.0 * DEG, 5.0 * DEG],
         sigma_sensors: None,
     }

@@ -343,6 +343,22 @@ pub const KEYS: &[Key] = &[
         "",
     ),
     key(
+        "align.max_heading_sigma_deg",
+        "align-max-heading-sigma",
+        "DEG",
+        Float,
+        "largest heading σ accepted from the GNSS course (σ_v/v and the turn over the baseline); a fix above it is passed over for a later one, deg",
+        "",
+    ),
+    key(
+        "align.baseline_s",
+        "align-baseline",
+        "S",
+        Float,
+        "baseline of the fixes whose chord gives the course for position-only GNSS, s",
+        "",
+    ),
+    key(
         "align.initial_yaw_deg",
         "initial-yaw-deg",
         "Y",

@@ -24,7 +24,7 @@ pub use keys::{KEYS, Key, ValueKind, key_by_path};
 use quantity::{Kind, parse_quantity};
 
 use crate::nav::filter::aids::{NhcConfig, StandstillConfig};
-use crate::nav::filter::model::{GaussMarkov, ImuNoise, QualityScale};
+use crate::nav::filter::model::{Gate, GaussMarkov, ImuNoise, QualityScale};
 use crate::nav::pipeline::{ImuGapPolicy, ImuStreamOptions, Mounting};
 
 /// The whole configuration (module docs). Every section and key has a default.
@@ -279,6 +279,10 @@ impl Default for NoiseMultipliers {
 pub struct AlignSection {
     /// Speed above which the GNSS course gives the heading, m/s.
     pub min_speed_m_s: f64,
+    /// Largest heading σ accepted from the GNSS course, deg.
+    pub max_heading_sigma_deg: f64,
+    /// Baseline of the fixes whose chord gives the course, s.
+    pub baseline_s: f64,
     /// Given initial yaw, deg.
     pub initial_yaw_deg: Option<f64>,
     /// Given initial roll, pitch, yaw, deg.
@@ -289,8 +293,15 @@ pub struct AlignSection {
 
 impl Default for AlignSection {
     fn default() -> Self {
+        let s =
+            crate::nav::session::SessionConfig::new(crate::nav::filter::model::FilterConfig::new(
+                crate::nav::session::consumer_mems_noise(),
+                [0.0; 3],
+            ));
         AlignSection {
-            min_speed_m_s: 1.0,
+            min_speed_m_s: s.min_speed_m_s,
+            max_heading_sigma_deg: s.max_heading_sigma_rad.to_degrees(),
+            baseline_s: s.align_baseline_s,
             initial_yaw_deg: None,
             initial_attitude_deg: None,
             static_s: 10.0,
@@ -767,6 +778,13 @@ impl NavConfig {
         let a = &self.align;
         nonneg("align.min_speed_m_s", a.min_speed_m_s, 1000.0, "m/s")?;
         nonneg("align.static_s", a.static_s, 3600.0, "s")?;
+        positive(
+            "align.max_heading_sigma_deg",
+            a.max_heading_sigma_deg,
+            180.0,
+            "deg",
+        )?;
+        positive("align.baseline_s", a.baseline_s, 600.0, "s")?;
         if let Some(y) = a.initial_yaw_deg {
             check_angles("align.initial_yaw_deg", [0.0, 0.0, y])?;
         }
@@ -820,7 +838,7 @@ impl NavConfig {
             "m/s",
         )?;
         nonneg("aids.nhc_min_speed_m_s", x.nhc_min_speed_m_s, 1000.0, "m/s")?;
-        self.gate_threshold()?;
+        self.gate()?;
         let o = &self.outages;
         o.spec
             .parse::<crate::nav::outage::OutageSpec>()
@@ -880,28 +898,14 @@ impl NavConfig {
         (h > 0.0 || v > 0.0).then_some((h, v))
     }
 
-    /// The χ² threshold of the gate (3 degrees of freedom); `None` = no gate.
-    pub fn gate_threshold(&self) -> Result<Option<f64>, KeyError> {
-        let g = self.filter.gate.trim();
-        match g {
-            "off" => Ok(None),
-            "robust" => Ok(Some(crate::nav::filter::model::CHI2_3DOF_P9999)),
-            _ => {
-                let p = g
-                    .strip_prefix("chi2:")
-                    .and_then(|p| p.parse::<f64>().ok())
-                    .filter(|p| *p > 0.0 && *p < 1.0)
-                    .ok_or_else(|| {
-                        key_err(
-                            "filter.gate",
-                            format!(
-                                "{g:?}: off, chi2:P with 0 < P < 1 (e.g. chi2:0.9999), or robust"
-                            ),
-                        )
-                    })?;
-                Ok(Some(crate::allan::ci::chi2::chi2_quantile(p, 3.0)))
-            }
-        }
+    /// The innovation gate ([`Gate`]: `off`, `chi2:P`, `robust` or
+    /// `robust:P_INFLATE:P_REJECT:MAX_SIGMA_SCALE`).
+    pub fn gate(&self) -> Result<Gate, KeyError> {
+        self.filter
+            .gate
+            .trim()
+            .parse::<Gate>()
+            .map_err(|e| key_err("filter.gate", e.to_string()))
     }
 
     /// The filter's noise model and the initial σ of its 12 sensor states, from the

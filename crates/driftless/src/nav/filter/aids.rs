@@ -103,13 +103,12 @@ pub struct NhcConfig {
     pub min_speed_m_s: f64,
     /// No NHC above this vehicle yaw rate |ω_z^v|, rad/s. Default 30°/s.
     pub max_yaw_rate_rad_s: f64,
-    /// χ² gate (2 dof) on the NHC innovation; `None` disables. Default
-    /// χ²₀.₉₉₉₉(2) = 18.42.
-    pub chi2_gate: Option<f64>,
+    /// Gate of the NHC update (2 dof); `None` (default) uses the filter's
+    /// [`super::FilterConfig::gate`]. Under the default robust gate an NHC innovation
+    /// larger than the constraint's σ explains (side slip, a kerb, a hand-held rig that
+    /// is not a vehicle) inflates R instead of being rejected.
+    pub gate: Option<super::Gate>,
 }
-
-/// χ²₀.₉₉₉₉ quantile for 2 degrees of freedom.
-pub const CHI2_2DOF_P9999: f64 = 18.421;
 
 impl Default for NhcConfig {
     fn default() -> Self {
@@ -120,7 +119,7 @@ impl Default for NhcConfig {
             interval_s: 0.1,
             min_speed_m_s: 1.0,
             max_yaw_rate_rad_s: 30.0 * DEG,
-            chi2_gate: Some(CHI2_2DOF_P9999),
+            gate: None,
         }
     }
 }
@@ -160,7 +159,7 @@ impl NhcConfig {
                 .lever_arm_b_m
                 .iter()
                 .all(|v| v.is_finite() && v.abs() < 100.0)
-            && self.chi2_gate.is_none_or(|g| g.is_finite() && g > 0.0);
+            && self.gate.is_none_or(|g| g.validate().is_ok());
         if !ok {
             return Err(NavError::Config(format!(
                 "NHC settings invalid (σ > 0 m/s, interval ≥ 0 s, min speed ≥ 0, max yaw \

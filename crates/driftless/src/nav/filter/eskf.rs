@@ -6,7 +6,8 @@
 //!   estimates (Δθ̂ = (Δθ̃ − b̂_gΔt) ⊘ (1 + ŝ_g), Δv̂ likewise), mechanize
 //!   ([`mechanize`]), propagate P with Φ and Q_d built at the state of the start of the
 //!   interval ([`super::model`]). The error state itself stays zero (closed loop).
-//! * [`Eskf::update_position`] / [`Eskf::update_velocity`]: innovation, χ² gate, gain,
+//! * [`Eskf::update_position`] / [`Eskf::update_velocity`]: innovation, gate
+//!   ([`Gate`]: off, χ² test, or robust inflation of R), gain,
 //!   Joseph-form covariance update (Bucy & Joseph; Brown & Hwang 2012 §4.2, eq. 4.2.18),
 //!   P⁺ = (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ, which keeps P symmetric PD under rounding and
 //!   for any K; then feedback of δx̂ = K y into the navigation state and the sensor
@@ -38,11 +39,12 @@
 use driftless_model::linalg::{Mat3, Vec3, add, cross, sub};
 
 use super::NavError;
-use super::model::{FilterConfig, Transition, omega_in, skew};
+use super::model::{FilterConfig, Gate, Transition, omega_in, skew};
 use super::state::{
     ATT, BA, BG, Cov, N_STATES, POS, SA, SG, SensorErrors, VEL, check_covariance,
     check_covariance_scaled, check_diagonal, state_name,
 };
+use crate::allan::ci::chi2_quantile;
 use crate::nav::attitude::Quat;
 use crate::nav::earth;
 use crate::nav::mechanization::{ImuIncrement, NavState, mechanize};
@@ -75,8 +77,11 @@ pub struct UpdateOutcome {
     pub innovation: Vec3,
     /// Normalized innovation squared yᵀS⁻¹y.
     pub nis: f64,
-    /// False when the χ² gate rejected the measurement (state and P untouched).
+    /// False when the gate rejected the measurement (state and P untouched).
     pub accepted: bool,
+    /// Factor λ ≥ 1 by which the robust gate ([`Gate::Robust`]) inflated R for this
+    /// update (1 when not inflated or not applied).
+    pub r_scale: f64,
 }
 
 /// The filter. See the module documentation.
@@ -89,19 +94,19 @@ pub struct Eskf {
     last_omega_b_rad_s: Vec3,
     q_c: [f64; N_STATES],
     neg_inv_tau: [f64; 12],
-    chi2_gate: Option<f64>,
+    gate: Gate,
     symmetry_tol: f64,
 }
 
 impl Eskf {
-    /// The χ² gate applied to GNSS updates.
-    pub fn chi2_gate(&self) -> Option<f64> {
-        self.chi2_gate
+    /// The gate applied to GNSS updates.
+    pub fn gate(&self) -> Gate {
+        self.gate
     }
 
-    /// Replace the χ² gate applied to GNSS updates (`None` = no gating).
-    pub fn set_chi2_gate(&mut self, gate: Option<f64>) {
-        self.chi2_gate = gate;
+    /// Replace the gate applied to GNSS updates.
+    pub fn set_gate(&mut self, gate: Gate) {
+        self.gate = gate;
     }
 
     /// A filter at `nav` with sensor-error estimates `sensors`, initial covariance
@@ -138,7 +143,7 @@ impl Eskf {
             last_omega_b_rad_s: [0.0; 3],
             q_c: cfg.q_c_diag(),
             neg_inv_tau: cfg.neg_inv_tau(),
-            chi2_gate: cfg.chi2_gate,
+            gate: cfg.gate,
             symmetry_tol: cfg.symmetry_tol,
         };
         f.nav.q_bn = f.nav.q_bn.normalized();
@@ -173,6 +178,51 @@ impl Eskf {
     /// never survives a predict or update).
     pub fn std(&self) -> [f64; N_STATES] {
         std::array::from_fn(|i| self.p[i][i].max(0.0).sqrt())
+    }
+
+    /// Re-initialise the navigation states: the position, velocity and attitude of `nav`
+    /// (its time is ignored; the filter's stays) with a diagonal covariance of the given
+    /// σ, uncorrelated with the sensor-error states, whose estimates and covariance are
+    /// kept. Used when the state has diverged from the measurements
+    /// ([`super::FilterConfig::gate_recovery_s`]).
+    pub fn reset_navigation(
+        &mut self,
+        nav: NavState,
+        sigma_pos_ned_m: Vec3,
+        sigma_vel_ned_m_s: Vec3,
+        sigma_att_rad: Vec3,
+    ) -> Result<(), NavError> {
+        let sig = sigma_pos_ned_m
+            .iter()
+            .chain(sigma_vel_ned_m_s.iter())
+            .chain(sigma_att_rad.iter());
+        let ok = [nav.lat_rad, nav.lon_rad, nav.height_m]
+            .iter()
+            .chain(nav.vel_ned_m_s.iter())
+            .chain(nav.q_bn.0.iter())
+            .all(|v| v.is_finite());
+        if !ok || !sig.clone().all(|s| s.is_finite() && *s > 0.0) {
+            return Err(NavError::InvalidMeasurement {
+                time_s: self.nav.time_s,
+                reason: format!("navigation reset to a non-finite state or σ: {nav:?}"),
+            });
+        }
+        let t = self.nav.time_s;
+        self.nav = NavState {
+            time_s: t,
+            q_bn: nav.q_bn.normalized(),
+            ..nav
+        };
+        for i in 0..9 {
+            for j in 0..N_STATES {
+                self.p[i][j] = 0.0;
+                self.p[j][i] = 0.0;
+            }
+        }
+        for (i, s) in sig.enumerate() {
+            self.p[i][i] = s * s;
+        }
+        Ok(())
     }
 
     /// Last compensated angular rate ω̂_ib^b, rad/s.
@@ -279,14 +329,7 @@ impl Eskf {
             }
         }
         const COLS: [usize; 6] = [POS, POS + 1, POS + 2, ATT, ATT + 1, ATT + 2];
-        self.update(
-            UpdateKind::Position,
-            y,
-            &h,
-            &COLS,
-            sigma_ned_m,
-            self.chi2_gate,
-        )
+        self.update(UpdateKind::Position, y, &h, &COLS, sigma_ned_m, self.gate)
     }
 
     /// GNSS velocity update: `v_ned_m_s` the antenna velocity, `sigma_ned_m_s` its σ.
@@ -318,14 +361,7 @@ impl Eskf {
             }
         }
         const COLS: [usize; 12] = [3, 4, 5, 6, 7, 8, 9, 10, 11, 15, 16, 17];
-        self.update(
-            UpdateKind::Velocity,
-            y,
-            &h,
-            &COLS,
-            sigma_ned_m_s,
-            self.chi2_gate,
-        )
+        self.update(UpdateKind::Velocity, y, &h, &COLS, sigma_ned_m_s, self.gate)
     }
 
     /// Non-holonomic constraint (land vehicle): the velocity of the wheel-contact /
@@ -351,7 +387,7 @@ impl Eskf {
         c_vb: &Mat3,
         lever_b_m: Vec3,
         sigma_m_s: [f64; 2],
-        gate: Option<f64>,
+        gate: Gate,
     ) -> Result<UpdateOutcome, NavError> {
         let t = self.nav.time_s;
         let sig3 = [sigma_m_s[0], sigma_m_s[1], 1.0];
@@ -385,11 +421,7 @@ impl Eskf {
 
     /// Zero-velocity update at standstill: z = v^n = 0 (the IMU at rest), y = v̂^n,
     /// H = [0, I₃, 0, …], R = σ²I (Groves 2013 §16.2.3; Shin 2005 ch. 5).
-    pub fn update_zupt(
-        &mut self,
-        sigma_m_s: f64,
-        gate: Option<f64>,
-    ) -> Result<UpdateOutcome, NavError> {
+    pub fn update_zupt(&mut self, sigma_m_s: f64, gate: Gate) -> Result<UpdateOutcome, NavError> {
         let t = self.nav.time_s;
         check_meas(t, &[0.0; 3], &[sigma_m_s; 3], &[0.0; 3])?;
         let mut h = [[0.0; N_STATES]; 3];
@@ -418,7 +450,7 @@ impl Eskf {
         raw_dtheta_rad: Vec3,
         dt_s: f64,
         sigma_rad_s: f64,
-        gate: Option<f64>,
+        gate: Gate,
     ) -> Result<UpdateOutcome, NavError> {
         let t = self.nav.time_s;
         check_meas(t, &raw_dtheta_rad, &[sigma_rad_s; 3], &[0.0; 3])?;
@@ -457,7 +489,7 @@ impl Eskf {
     }
 
     /// Generic M-dimensional update (M = 2 or 3) with H non-zero only in `cols`,
-    /// R = diag(σ²), χ² gate `gate` on the NIS.
+    /// R = diag(σ²), gated by `gate` ([`Gate`]).
     fn update<const M: usize>(
         &mut self,
         kind: UpdateKind,
@@ -465,7 +497,7 @@ impl Eskf {
         h: &[[f64; N_STATES]; M],
         cols: &[usize],
         sigma: [f64; M],
-        gate: Option<f64>,
+        gate: Gate,
     ) -> Result<UpdateOutcome, NavError> {
         const { assert!(M >= 1 && M <= 3) };
         let t = self.nav.time_s;
@@ -484,46 +516,39 @@ impl Eskf {
                 *v = cols.iter().map(|&c| p[i][c] * h[m][c]).sum();
             }
         }
-        let r = sigma.map(|s| s * s);
-        // S, padded to 3 × 3 with an identity block (its inverse then carries the
-        // inverse of the M × M block unchanged).
-        let mut s = [[0.0; 3]; 3];
-        for m in M..3 {
-            s[m][m] = 1.0;
-        }
+        let r0 = sigma.map(|s| s * s);
+        // H P Hᵀ (M × M block of S without R).
+        let mut hph = [[0.0; 3]; 3];
         for m in 0..M {
             for n in 0..M {
-                s[m][n] = cols.iter().map(|&c| h[m][c] * pht[c][n]).sum::<f64>();
-            }
-            s[m][m] += r[m];
-        }
-        // Symmetrize S against rounding before inverting.
-        for m in 0..3 {
-            for n in (m + 1)..3 {
-                let a = 0.5 * (s[m][n] + s[n][m]);
-                s[m][n] = a;
-                s[n][m] = a;
+                hph[m][n] = cols.iter().map(|&c| h[m][c] * pht[c][n]).sum::<f64>();
             }
         }
-        let s_inv = Mat3(s).inverse().ok_or_else(|| NavError::Covariance {
-            time_s: t,
-            diagnosis: format!("innovation covariance S = {s:?} is singular"),
-        })?;
-        let siy: [f64; M] =
-            std::array::from_fn(|m| (0..M).map(|n| s_inv.0[m][n] * y[n]).sum::<f64>());
-        let mut nis = 0.0;
-        for m in 0..M {
-            nis += y[m] * siy[m];
-        }
-        if !nis.is_finite() || nis < 0.0 {
-            return Err(NavError::Covariance {
-                time_s: t,
-                diagnosis: format!(
-                    "innovation covariance S = {s:?} is not positive definite (NIS {nis})"
-                ),
-            });
-        }
-        let accepted = gate.is_none_or(|g| nis <= g);
+        // S⁻¹ and the NIS for R scaled by λ.
+        let solve = |lambda: f64| innovation_test::<M>(t, &hph, &r0, lambda, &y);
+        let (mut s_inv, nis) = solve(1.0)?;
+        let mut lambda = 1.0;
+        let accepted = match gate {
+            Gate::Off => true,
+            Gate::Chi2 { p } => nis <= chi2_quantile(p, M as f64),
+            Gate::Robust {
+                p_inflate,
+                p_reject,
+                max_sigma_scale,
+            } => {
+                let c = chi2_quantile(p_inflate, M as f64);
+                if nis <= c {
+                    true
+                } else {
+                    let lambda_max = max_sigma_scale * max_sigma_scale;
+                    let (_, nis_max) = solve(lambda_max)?;
+                    lambda = (nis / c).min(lambda_max);
+                    s_inv = solve(lambda)?.0;
+                    nis_max <= chi2_quantile(p_reject, M as f64)
+                }
+            }
+        };
+        let r = r0.map(|v| v * lambda);
         let mut innovation = [0.0; 3];
         innovation[..M].copy_from_slice(&y);
         let out = UpdateOutcome {
@@ -532,6 +557,7 @@ impl Eskf {
             innovation,
             nis,
             accepted,
+            r_scale: if accepted { lambda } else { 1.0 },
         };
         if !accepted {
             return Ok(out);
@@ -625,6 +651,52 @@ pub(crate) fn apply_error_state(n: &mut NavState, s: &mut SensorErrors, dx: &[f6
         s.gyro_scale[k] += dx[SG + k];
         s.accel_scale[k] += dx[SA + k];
     }
+}
+
+/// S = H P Hᵀ + λR (padded to 3 × 3 with an identity block, whose inverse then carries
+/// the inverse of the M × M block unchanged), its inverse and the NIS yᵀS⁻¹y.
+fn innovation_test<const M: usize>(
+    t: f64,
+    hph: &[[f64; 3]; 3],
+    r: &[f64; M],
+    lambda: f64,
+    y: &[f64; M],
+) -> Result<(Mat3, f64), NavError> {
+    let mut s = [[0.0; 3]; 3];
+    for m in M..3 {
+        s[m][m] = 1.0;
+    }
+    for m in 0..M {
+        s[m][..M].copy_from_slice(&hph[m][..M]);
+        s[m][m] += lambda * r[m];
+    }
+    // Symmetrize S against rounding before inverting.
+    for m in 0..3 {
+        for n in (m + 1)..3 {
+            let a = 0.5 * (s[m][n] + s[n][m]);
+            s[m][n] = a;
+            s[n][m] = a;
+        }
+    }
+    let s_inv = Mat3(s).inverse().ok_or_else(|| NavError::Covariance {
+        time_s: t,
+        diagnosis: format!("innovation covariance S = {s:?} is singular"),
+    })?;
+    let mut nis = 0.0;
+    for m in 0..M {
+        for n in 0..M {
+            nis += y[m] * s_inv.0[m][n] * y[n];
+        }
+    }
+    if !nis.is_finite() || nis < 0.0 {
+        return Err(NavError::Covariance {
+            time_s: t,
+            diagnosis: format!(
+                "innovation covariance S = {s:?} is not positive definite (NIS {nis})"
+            ),
+        });
+    }
+    Ok((s_inv, nis))
 }
 
 fn check_meas(t: f64, value: &[f64; 3], sigma: &Vec3, lever: &Vec3) -> Result<(), NavError> {

@@ -6,7 +6,7 @@
 //! * [`model`]: continuous-time error dynamics F, process noise, discretization and the
 //!   block-sparse covariance propagation.
 //! * [`eskf`]: the filter ([`Eskf`]): predict, GNSS position/velocity updates with lever
-//!   arm, χ² gating, Joseph form, feedback and reset, covariance health checks.
+//!   arm, innovation gating ([`Gate`]), Joseph form, feedback and reset, covariance health checks.
 //! * [`run`]: [`run_forward`], the forward pass over an IMU log and GNSS fixes (IMU
 //!   increment split at GNSS epochs, outage windows) storing what an RTS smoother needs.
 //! * [`aids`]: land-vehicle aids — non-holonomic constraint, standstill detection,
@@ -41,7 +41,9 @@ pub use align::{
     AlignConfig, Alignment, coarse_align_static, heading_from_gnss_velocity, level_static,
 };
 pub use eskf::{Eskf, UpdateKind, UpdateOutcome};
-pub use model::{FilterConfig, GaussMarkov, ImuNoise, QualityScale, Transition};
+pub use model::{
+    FilterConfig, GATE_CHOICES, Gate, GaussMarkov, ImuNoise, QualityScale, Transition,
+};
 pub use run::{
     EpochRecord, ForwardRun, InitialState, UpdateRecord, run_forward, run_forward_observed,
 };

@@ -11,9 +11,36 @@
 //! first-order interpolation KF-GINS and Shin 2005 use; the two-sample corrections of
 //! the split parts see the preceding part as their previous increment). Fixes within
 //! 1 µs of an epoch are applied at the epoch. Fixes inside an outage window
-//! ([`FilterConfig::outages_s`]) are withheld; fixes before the initial state or out of
-//! order are skipped and counted. Each fix's σ is multiplied by the quality factor of
-//! its RTKLIB flag ([`super::QualityScale`]).
+//! ([`FilterConfig::outages_s`], half-open (start, end]) are withheld; fixes before the
+//! initial state or out of order are skipped and counted, and so are fixes whose quality
+//! flag is not in [`FilterConfig::accept_quality`] (when that is not empty). Each fix's σ
+//! is multiplied by the quality factor of its RTKLIB flag ([`super::QualityScale`]).
+//!
+//! # Gating and its recovery
+//!
+//! Every update is gated by [`FilterConfig::gate`] (the NHC by its own gate when it sets
+//! one). Two rules keep the filter from starving:
+//!
+//! * **Gate recovery** ([`FilterConfig::gate_recovery_s`] = R): the time since the last
+//!   accepted position fix is counted *outside* the outage windows only, i.e.
+//!   τ = (t_fix − t_accept) − |(t_accept, t_fix] ∩ ⋃ windows|. When τ > R the fix is
+//!   applied with [`super::Gate::Off`] (counted in [`ForwardRun::gnss_forced`]): a state
+//!   that every fix contradicts for R seconds of GNSS coverage has diverged (e.g. after
+//!   an IMU fault) and the fixes are trusted over it. When that fix is a gross outlier
+//!   even for the default robust gate at its ceiling (the state is far off, not merely
+//!   over-confident), the navigation states are first re-initialised
+//!   ([`Eskf::reset_navigation`], counted in [`ForwardRun::gnss_resets`]): position from
+//!   the fix (lever arm removed); velocity from the chord to the previous fix when it is
+//!   at most 2R earlier (σ the chord's, at least 1 m/s), else zero with σ 10 m/s; roll
+//!   and pitch levelled from the mean specific force of the last second (exponential
+//!   mean, time constant 1 s; σ 5°, covering accelerations up to ≈ 0.9 m/s²), yaw kept
+//!   with σ at least 10°; the sensor-error states are kept. A gyro fault about a level
+//!   body's x or y axis (a roll or pitch jump) is thus undone; a yaw jump is not
+//!   observable this way and is left to the filter.
+//! * **First fix after an outage window**: under [`super::Gate::Robust`] it is applied
+//!   with the robust weight but never rejected ([`super::Gate::never_reject`]), so an
+//!   outage is never lengthened by rejected fixes because the window was long. Under
+//!   [`super::Gate::Chi2`] it is tested like any fix (the user asked for the χ² test).
 //!
 //! # Storage for the smoother (memory per epoch)
 //!
@@ -49,6 +76,7 @@ use super::eskf::{Eskf, UpdateKind, UpdateOutcome};
 use super::model::{FilterConfig, Transition};
 use super::state::{ATT, BG, Cov, N_STATES, PackedCov, SensorErrors, VEL, pack};
 use crate::io::nav::GnssFixes;
+use crate::nav::attitude::Euler;
 use crate::nav::earth;
 use crate::nav::mechanization::{ImuIncrement, NavState};
 
@@ -144,11 +172,20 @@ pub struct ForwardRun {
     pub gnss_withheld: usize,
     /// Fixes before the initial state, after the last IMU epoch, or out of order.
     pub gnss_skipped: usize,
-    /// Measurements rejected by the χ² gate (each logged in `updates`).
+    /// Fixes skipped because their quality flag is not in
+    /// [`FilterConfig::accept_quality`].
+    pub gnss_quality_skipped: usize,
+    /// Measurements rejected by the gate (each logged in `updates`).
     pub gnss_rejected: usize,
+    /// Accepted measurements whose R the robust gate inflated
+    /// ([`super::Gate::Robust`]; a subset of `gnss_accepted`).
+    pub gnss_inflated: usize,
     /// Position fixes applied without the gate by the gate-recovery rule
     /// ([`FilterConfig::gate_recovery_s`]).
     pub gnss_forced: usize,
+    /// Forced fixes before which the navigation states were re-initialised (module docs;
+    /// a subset of `gnss_forced`).
+    pub gnss_resets: usize,
     /// Measurements accepted.
     pub gnss_accepted: usize,
     /// NHC updates accepted ([`super::aids`]).
@@ -157,8 +194,10 @@ pub struct ForwardRun {
     pub zupt_applied: usize,
     /// ZARU updates accepted.
     pub zaru_applied: usize,
-    /// NHC / ZUPT / ZARU updates rejected by their χ² gates (logged in `updates`).
+    /// NHC / ZUPT / ZARU updates rejected by their gates (logged in `updates`).
     pub aids_rejected: usize,
+    /// Accepted NHC / ZUPT / ZARU updates whose R the robust gate inflated.
+    pub aids_inflated: usize,
     /// Detected standstill intervals (start, end), s ([`super::aids`]).
     pub standstills: Vec<(f64, f64)>,
     /// Index in the whole run of `epochs[0]`: 0, unless the records were handed to an
@@ -189,7 +228,7 @@ impl ForwardRun {
         ))
     }
 
-    /// The rejected measurements (χ² gate).
+    /// The rejected measurements (gate).
     pub fn rejections(&self) -> impl Iterator<Item = &UpdateOutcome> {
         self.updates
             .iter()
@@ -256,11 +295,93 @@ struct Ctx<'a> {
     gnss_speed: Option<(f64, f64)>,
     /// Time of the latest accepted position fix (the start time before any).
     last_position_accept_s: f64,
+    /// Time of the latest fix handed to [`Ctx::apply_fix`] (the start time before any).
+    last_fix_s: f64,
+    /// That fix: (time, (lat, lon, h), horizontal σ after the quality scaling).
+    prev_fix: Option<(f64, (f64, f64, f64), f64)>,
+    /// Exponential mean (time constant 1 s) of the raw specific force, body, m/s².
+    f_mean_b: Option<Vec3>,
 }
 
 impl Ctx<'_> {
+    /// Fix at `t` withheld by an outage window (start, end].
     fn withheld(&self, t: f64) -> bool {
-        self.cfg.outages_s.iter().any(|&(a, b)| t >= a && t <= b)
+        self.cfg.outages_s.iter().any(|&(a, b)| a < t && t <= b)
+    }
+
+    /// Fix `g` not used because of its quality flag.
+    fn quality_skipped(&self, g: usize) -> bool {
+        let q = &self.cfg.accept_quality;
+        !q.is_empty() && !q.contains(&self.gnss.quality[g])
+    }
+
+    /// Length of (t0, t1] outside every outage window, s.
+    fn time_outside_windows(&self, t0: f64, t1: f64) -> f64 {
+        let mut cut: Vec<(f64, f64)> = self
+            .cfg
+            .outages_s
+            .iter()
+            .map(|&(a, b)| (a.max(t0), b.min(t1)))
+            .filter(|(a, b)| b > a)
+            .collect();
+        cut.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let (mut inside, mut reach) = (0.0, f64::NEG_INFINITY);
+        for (a, b) in cut {
+            let a = a.max(reach);
+            if b > a {
+                inside += b - a;
+            }
+            reach = reach.max(b);
+        }
+        (t1 - t0 - inside).max(0.0)
+    }
+
+    /// Re-initialise the navigation states at the fix `llh` (module docs, gate recovery).
+    fn reset_to_fix(
+        &self,
+        f: &mut Eskf,
+        llh: [f64; 3],
+        sigma: Vec3,
+        prev_fix: Option<(f64, (f64, f64, f64), f64)>,
+    ) -> Result<(), NavError> {
+        let t = f.nav().time_s;
+        let yaw = Euler::from_dcm(&f.nav().q_bn.to_dcm()).yaw_rad;
+        let (roll, pitch) = match self.f_mean_b {
+            Some(fm) if norm(fm) > 1.0 => ((-fm[1]).atan2(-fm[2]), fm[0].atan2(fm[1].hypot(fm[2]))),
+            _ => (0.0, 0.0),
+        };
+        let q_bn = Euler {
+            roll_rad: roll,
+            pitch_rad: pitch,
+            yaw_rad: yaw,
+        }
+        .to_quat();
+        let l_n = q_bn.rotate(self.cfg.lever_arm_b_m);
+        let rm = earth::meridian_radius_m(llh[0]) + llh[2];
+        let rn = earth::prime_vertical_radius_m(llh[0]) + llh[2];
+        let max_chord_s = 2.0 * self.cfg.gate_recovery_s.unwrap_or(0.0);
+        let (vel, sigma_v) = match prev_fix {
+            Some((tp, p, sp)) if t - tp > 0.0 && t - tp <= max_chord_s => {
+                let d = earth::ned_offset_m(p, (llh[0], llh[1], llh[2]));
+                let dt = t - tp;
+                (
+                    d.map(|x| x / dt),
+                    (sp.hypot(sigma[0].max(sigma[1])) / dt).max(1.0),
+                )
+            }
+            _ => ([0.0; 3], 10.0),
+        };
+        let nav = NavState {
+            time_s: t,
+            lat_rad: llh[0] - l_n[0] / rm,
+            lon_rad: llh[1] - l_n[1] / (rn * llh[0].cos()),
+            height_m: llh[2] + l_n[2],
+            vel_ned_m_s: vel,
+            q_bn,
+        };
+        let sigma_yaw = f.std()[ATT + 2].max(10f64.to_radians());
+        let tilt = 5f64.to_radians();
+        f.reset_navigation(nav, sigma, [sigma_v; 3], [tilt, tilt, sigma_yaw])
     }
 
     /// Apply fix `g` at the current filter epoch and refresh the last record.
@@ -271,24 +392,36 @@ impl Ctx<'_> {
         let mut outcomes = Vec::with_capacity(2);
         let sigma = gn.sigma_ned_m[g].map(|s| s * k);
         let t_fix = gn.time_s[g];
-        // The recovery clock restarts at the end of the latest outage window.
-        let since = self
+        // Recovery clock: time without an accepted position fix, outside the windows.
+        let starved = self.time_outside_windows(self.last_position_accept_s, t_fix);
+        let forced = self.cfg.gate_recovery_s.is_some_and(|r| starved > r);
+        let after_window = self
             .cfg
             .outages_s
             .iter()
-            .filter(|&&(_, b)| b <= t_fix)
-            .fold(self.last_position_accept_s, |acc, &(_, b)| acc.max(b));
-        let forced = self.cfg.gate_recovery_s.is_some_and(|r| t_fix - since > r);
-        let gate = f.chi2_gate();
+            .any(|&(_, b)| b >= self.last_fix_s && b < t_fix);
+        self.last_fix_s = t_fix;
+        let llh = [gn.lat_rad[g], gn.lon_rad[g], gn.height_m[g]];
+        let prev_fix =
+            self.prev_fix
+                .replace((t_fix, (llh[0], llh[1], llh[2]), sigma[0].max(sigma[1])));
+        let gate = f.gate();
         if forced {
-            f.set_chi2_gate(None);
+            let mut trial = f.clone();
+            trial.set_gate(super::Gate::default());
+            let gross = trial
+                .update_position(llh, sigma, self.cfg.lever_arm_b_m)
+                .map_or(true, |o| !o.accepted);
+            if gross {
+                self.reset_to_fix(f, llh, sigma, prev_fix)?;
+                self.run.gnss_resets += 1;
+            }
+            f.set_gate(super::Gate::Off);
+        } else if after_window && matches!(gate, super::Gate::Robust { .. }) {
+            f.set_gate(gate.never_reject());
         }
-        let o = f.update_position(
-            [gn.lat_rad[g], gn.lon_rad[g], gn.height_m[g]],
-            sigma,
-            self.cfg.lever_arm_b_m,
-        );
-        f.set_chi2_gate(gate);
+        let o = f.update_position(llh, sigma, self.cfg.lever_arm_b_m);
+        f.set_gate(gate);
         let o = o?;
         if o.accepted {
             self.last_position_accept_s = t_fix;
@@ -310,6 +443,9 @@ impl Ctx<'_> {
         for o in &outcomes {
             if o.accepted {
                 self.run.gnss_accepted += 1;
+                if o.r_scale > 1.0 {
+                    self.run.gnss_inflated += 1;
+                }
             } else {
                 self.run.gnss_rejected += 1;
             }
@@ -391,6 +527,9 @@ pub fn run_forward_observed(
         cfg,
         gnss_speed: None,
         last_position_accept_s: t0,
+        last_fix_s: t0,
+        prev_fix: None,
+        f_mean_b: None,
         run: ForwardRun {
             epochs: Vec::with_capacity(if keep_epochs {
                 imu.len() - start + gnss.len() + 1
@@ -401,13 +540,17 @@ pub fn run_forward_observed(
             updates: Vec::new(),
             gnss_withheld: 0,
             gnss_skipped: 0,
+            gnss_quality_skipped: 0,
             gnss_rejected: 0,
+            gnss_inflated: 0,
             gnss_forced: 0,
+            gnss_resets: 0,
             gnss_accepted: 0,
             nhc_applied: 0,
             zupt_applied: 0,
             zaru_applied: 0,
             aids_rejected: 0,
+            aids_inflated: 0,
             standstills: Vec::new(),
             neg_inv_tau: cfg.neg_inv_tau(),
         },
@@ -434,6 +577,8 @@ pub fn run_forward_observed(
     while g < ng && gnss.time_s[g] <= t0 + EPS_T {
         if ctx.withheld(gnss.time_s[g]) {
             ctx.run.gnss_withheld += 1;
+        } else if ctx.quality_skipped(g) {
+            ctx.run.gnss_quality_skipped += 1;
         } else {
             ctx.apply_fix(&mut f, g)?;
         }
@@ -459,6 +604,14 @@ pub fn run_forward_observed(
                 reason: format!("gap of {dt} s after {t_prev} s (nominal interval {nominal_dt} s)"),
             });
         }
+        let f_now = inc.dvel_m_s.map(|v| v / dt);
+        ctx.f_mean_b = Some(match ctx.f_mean_b {
+            Some(m) => {
+                let a = dt.min(1.0);
+                std::array::from_fn(|k| m[k] + a * (f_now[k] - m[k]))
+            }
+            None => f_now,
+        });
         let mut rest = ImuIncrement { dt_s: dt, ..*inc };
         let mut t_start = t_prev;
         let mut done = false;
@@ -473,6 +626,11 @@ pub fn run_forward_observed(
             }
             if ctx.withheld(tg) {
                 ctx.run.gnss_withheld += 1;
+                g += 1;
+                continue;
+            }
+            if ctx.quality_skipped(g) {
+                ctx.run.gnss_quality_skipped += 1;
                 g += 1;
                 continue;
             }
@@ -605,14 +763,14 @@ impl AidState {
                     self.next_zero_s = t + ss.interval_s;
                     p_prior = Some(pack(f.covariance()));
                     if let Some(s) = ss.zupt_sigma_m_s {
-                        outcomes.push(f.update_zupt(s, ctx.cfg.chi2_gate)?);
+                        outcomes.push(f.update_zupt(s, ctx.cfg.gate)?);
                     }
                     if let Some(s) = ss.zaru_sigma_rad_s {
                         outcomes.push(f.update_zaru(
                             self.zaru_dtheta,
                             self.zaru_dt,
                             s,
-                            ctx.cfg.chi2_gate,
+                            ctx.cfg.gate,
                         )?);
                     }
                     self.zaru_dtheta = [0.0; 3];
@@ -640,7 +798,7 @@ impl AidState {
                     &nhc.c_vb,
                     nhc.lever_arm_b_m,
                     nhc.sigma_m_s,
-                    nhc.chi2_gate,
+                    nhc.gate.unwrap_or(ctx.cfg.gate),
                 )?);
             }
         }
@@ -649,6 +807,9 @@ impl AidState {
         };
         let run = &mut ctx.run;
         for o in &outcomes {
+            if o.accepted && o.r_scale > 1.0 {
+                run.aids_inflated += 1;
+            }
             match (o.accepted, o.kind) {
                 (false, _) => run.aids_rejected += 1,
                 (true, UpdateKind::Nhc) => run.nhc_applied += 1,
