@@ -6,6 +6,7 @@
 pub mod attitude;
 pub mod earth;
 pub mod filter;
+pub mod kfgins_job;
 pub mod mechanization;
 pub mod outage;
 pub mod pipeline;

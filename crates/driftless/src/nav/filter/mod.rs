@@ -43,7 +43,8 @@ pub use align::{
 pub use eskf::{Eskf, UpdateKind, UpdateOutcome};
 pub use model::{FilterConfig, GaussMarkov, ImuNoise, QualityScale, Transition};
 pub use run::{
-    EpochRecord, ForwardRun, InitialState, UpdateRecord, run_forward, run_forward_observed,
+    EpochRecord, ForwardRun, InitialState, RunOptions, UpdateRecord, run_forward,
+    run_forward_observed, run_forward_with,
 };
 pub use smoother::{SmoothedEpoch, SmoothedRun, smooth, smooth_with_covariances};
 pub use state::{N_STATES, SensorErrors};
