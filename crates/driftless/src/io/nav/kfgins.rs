@@ -23,7 +23,8 @@
 //! C's `"%-15.9lf "` (left-aligned, width 15, 9 decimals, one space after), lines ending
 //! in `\n`:
 //! * `KF_GINS_Navresult.nav`: `week, time [s], lat [deg], lon [deg], h [m], vN, vE, vD
-//!   [m/s], roll, pitch, yaw [deg]` — KF-GINS always writes 0 as the week.
+//!   [m/s], roll, pitch, yaw [deg]` — KF-GINS always writes 0 as the week, and yaw in
+//!   \[0°, 360°) ([`kfgins_heading_rad`]; the writers here write the yaw they are given).
 //! * `KF_GINS_IMU_ERR.txt`: `time, gyro bias xyz [deg/h], accel bias xyz [mGal], gyro
 //!   scale xyz [ppm], accel scale xyz [ppm]`.
 //! * `KF_GINS_STD.txt`: `time, pos NED [m], vel NED [m/s], att [deg], gyro bias [deg/h],
@@ -494,16 +495,17 @@ fn put_value(out: &mut [u8], v: f64) -> Option<usize> {
     if !(a < 1.0e8) {
         return None;
     }
-    // truncation by conversion (exact below 2^53), no libm call
-    let int0 = a as u64;
+    // Truncation by conversion (exact below 2^53), no libm call; through i64, which
+    // converts to and from f64 in one instruction (u64 needs a branchy sequence).
+    let int0 = a as i64;
     let f = (a - int0 as f64) * 1e9;
-    let f_floor = f as u64;
+    let f_floor = f as i64;
     let rem = f - f_floor as f64;
     if (rem - 0.5).abs() <= 1e-6 {
         return None;
     }
-    let mut int = int0;
-    let mut frac = f_floor + u64::from(rem > 0.5);
+    let mut int = int0 as u64;
+    let mut frac = f_floor as u64 + u64::from(rem > 0.5);
     if frac >= 1_000_000_000 {
         frac -= 1_000_000_000;
         int += 1;
@@ -974,9 +976,18 @@ impl KfGinsOutputWriter {
         std: &NavStd,
     ) -> Result<(), LogError> {
         let [nav_w, err_w, std_w] = &mut self.files;
-        let n = append_nav(nav_w, &self.names[0], sol, self.gps_week, self.rows)?;
-        let m = append_imu_err(err_w, &self.names[1], imu_err, self.rows)?;
-        let k = append_std(std_w, &self.names[2], std, self.rows)?;
+        let (names, rows, week) = (&self.names, self.rows, self.gps_week);
+        // Formatting-bound: the std file (22 columns) beside the other two (24).
+        let ((n, m), k) = rayon::join(
+            || {
+                (
+                    append_nav(nav_w, &names[0], sol, week, rows),
+                    append_imu_err(err_w, &names[1], imu_err, rows),
+                )
+            },
+            || append_std(std_w, &names[2], std, rows),
+        );
+        let (n, m, k) = (n?, m?, k?);
         if n != m || n != k {
             return Err(lens_err(
                 &self.names[0],

@@ -10,7 +10,9 @@
 //! remainder (1 − α); the filter predicts to t_g, updates, and continues (the same
 //! first-order interpolation KF-GINS and Shin 2005 use; the two-sample corrections of
 //! the split parts see the preceding part as their previous increment). Fixes within
-//! 1 µs of an epoch are applied at the epoch. Fixes inside an outage window
+//! 1 µs of an epoch are applied at the epoch. The record of each split point is listed in
+//! [`ForwardRun::split_points`]; [`RunOptions::observe_split_points`] false hands an
+//! observer only the whole-epoch records (one per IMU epoch, as KF-GINS writes them). Fixes inside an outage window
 //! ([`FilterConfig::outages_s`]) are withheld; fixes before the initial state or out of
 //! order are skipped and counted. Each fix's σ is multiplied by the quality factor of
 //! its RTKLIB flag ([`super::QualityScale`]).
