@@ -35,7 +35,8 @@ use std::path::{Path, PathBuf};
 
 use super::types::{GnssFixes, ImuErrors, ImuIncrements, NavSolution, NavStd, common_len};
 use super::{
-    Field, as_utf8, check_time_order, parse_num, read_file, split_fields, split_fields_into,
+    Field, as_utf8, as_utf8_from, check_time_order, parse_num, read_file, split_fields,
+    split_fields_into,
 };
 use crate::io::{Location, LogError};
 
@@ -177,10 +178,66 @@ const IMU_NAMES: [&str; 7] = [
     "dvel_z_m_s",
 ];
 
-/// Reads a KF-GINS IMU text file (see the module docs for the format).
+/// Reads a KF-GINS IMU text file (see the module docs for the format). The file is read
+/// in chunks of whole lines ([`IMU_READ_CHUNK`] bytes) into one reused buffer, each chunk
+/// parsed in parallel blocks as [`read_kfgins_imu`] does — the same result and errors,
+/// without holding (and page-faulting) the whole text in memory.
 pub fn read_kfgins_imu_file(path: impl AsRef<Path>) -> Result<ImuIncrements, LogError> {
-    let path = path.as_ref();
-    read_kfgins_imu(&read_file(path)?, &path.display().to_string())
+    read_imu_file_chunked(path.as_ref(), IMU_READ_CHUNK, IMU_BLOCK_BYTES)
+}
+
+/// [`read_kfgins_imu_file`] with chunks of `chunk` bytes parsed in blocks of `block`.
+fn read_imu_file_chunked(
+    path: &Path,
+    chunk: usize,
+    block: usize,
+) -> Result<ImuIncrements, LogError> {
+    use std::io::Read as _;
+    let chunk = chunk.max(2);
+    let name = path.display().to_string();
+    let io_err = |error| LogError::Io {
+        path: name.clone(),
+        error,
+    };
+    let mut file = std::fs::File::open(path).map_err(io_err)?;
+    // Shortest possible row: seven one-digit fields and separators, 14 bytes. Reserved
+    // address space is not touched beyond the rows actually read.
+    let len = file.metadata().map_or(0, |m| m.len()) as usize;
+    let rows = len / 14 + 1;
+    let mut out = ImuIncrements {
+        time_s: Vec::with_capacity(rows),
+        dtheta_rad: Vec::with_capacity(rows),
+        dvel_m_s: Vec::with_capacity(rows),
+    };
+    let mut st = ImuTextState::default();
+    let mut buf: Vec<u8> = Vec::with_capacity(chunk + (1 << 16));
+    let mut eof = false;
+    while !eof {
+        // Fill the buffer to a chunk (more if no line ends in it).
+        let want = buf.len().max(chunk / 2) + chunk / 2;
+        while buf.len() < want {
+            let at = buf.len();
+            buf.resize(want, 0);
+            let n = file.read(&mut buf[at..]).map_err(io_err)?;
+            buf.truncate(at + n);
+            if n == 0 {
+                eof = true;
+                break;
+            }
+        }
+        let cut = if eof {
+            buf.len()
+        } else {
+            match buf.iter().rposition(|&b| b == b'\n') {
+                Some(p) => p + 1,
+                None => continue,
+            }
+        };
+        parse_imu_text(&buf[..cut], &name, block, &mut st, &mut out)?;
+        buf.drain(..cut);
+    }
+    finish_imu_text(&st, &name)?;
+    Ok(out)
 }
 
 /// Reads KF-GINS IMU text from memory; `name` is used in error messages. Large inputs
@@ -190,39 +247,84 @@ pub fn read_kfgins_imu(bytes: &[u8], name: &str) -> Result<ImuIncrements, LogErr
     read_imu_in_blocks(bytes, name, IMU_BLOCK_BYTES)
 }
 
+/// Bytes [`read_kfgins_imu_file`] reads and parses at a time.
+pub const IMU_READ_CHUNK: usize = 16 << 20;
+
+/// What parsing a text in pieces of whole lines carries from one piece to the next.
+#[derive(Default)]
+struct ImuTextState {
+    /// 1-based number of the next piece's first line.
+    line0: usize,
+    /// The first data row's line and field count, once seen.
+    reference: Option<(usize, usize)>,
+}
+
 fn read_imu_in_blocks(
     bytes: &[u8],
     name: &str,
     block_bytes: usize,
 ) -> Result<ImuIncrements, LogError> {
-    use rayon::prelude::*;
-    let text = as_utf8(bytes, name)?;
-    // The first data row fixes the column count of all rows.
-    let Some((ref_line, first)) = data_lines(text).next() else {
-        return Err(LogError::Empty {
+    let mut st = ImuTextState::default();
+    let mut out = ImuIncrements::default();
+    parse_imu_text(bytes, name, block_bytes, &mut st, &mut out)?;
+    finish_imu_text(&st, name)?;
+    Ok(out)
+}
+
+/// An input without a data row is an error.
+fn finish_imu_text(st: &ImuTextState, name: &str) -> Result<(), LogError> {
+    match st.reference {
+        Some(_) => Ok(()),
+        None => Err(LogError::Empty {
             at: Location::input(name),
-        });
-    };
-    let expected = split_fields(first, SEPS).len();
-    if expected < 7 {
-        return Err(LogError::Ragged {
-            at: Location::field(name, ref_line, first.len() + 1),
-            found: expected,
-            expected: 7,
-            reference_line: ref_line,
-        });
+        }),
     }
-    let blocks = line_blocks(text, block_bytes.max(1));
+}
+
+/// Parses `bytes`, whole lines continuing the text of `st`, in parallel blocks of about
+/// `block_bytes`, appending the rows to `out`; the first error in file order wins.
+fn parse_imu_text(
+    bytes: &[u8],
+    name: &str,
+    block_bytes: usize,
+    st: &mut ImuTextState,
+    out: &mut ImuIncrements,
+) -> Result<(), LogError> {
+    use rayon::prelude::*;
+    let line0 = st.line0.max(1);
+    let text = as_utf8_from(bytes, name, line0)?;
+    // The first data row fixes the column count of all rows.
+    let (ref_line, expected) = match st.reference {
+        Some(r) => r,
+        None => {
+            let Some((line, first)) = data_lines(text).next() else {
+                st.line0 = line0 + text.bytes().filter(|&b| b == b'\n').count();
+                return Ok(());
+            };
+            let line = line + line0 - 1;
+            let expected = split_fields(first, SEPS).len();
+            if expected < 7 {
+                return Err(LogError::Ragged {
+                    at: Location::field(name, line, first.len() + 1),
+                    found: expected,
+                    expected: 7,
+                    reference_line: line,
+                });
+            }
+            st.reference = Some((line, expected));
+            (line, expected)
+        }
+    };
+    let blocks = line_blocks(text, block_bytes.max(1), line0);
+    st.line0 = blocks.last().map_or(line0, |b| b.0 + b.2);
     let parts: Vec<ImuBlock> = blocks
         .par_iter()
-        .map(|&(line0, block)| parse_imu_block(block, line0, expected, ref_line, name))
+        .map(|&(line0, block, _)| parse_imu_block(block, line0, expected, ref_line, name))
         .collect();
     let n = parts.iter().map(|p| p.data.len()).sum();
-    let mut out = ImuIncrements {
-        time_s: Vec::with_capacity(n),
-        dtheta_rad: Vec::with_capacity(n),
-        dvel_m_s: Vec::with_capacity(n),
-    };
+    out.time_s.reserve(n);
+    out.dtheta_rad.reserve(n);
+    out.dvel_m_s.reserve(n);
     for part in parts {
         // Time order across the block boundary, at the block's first data line.
         if let (Some(&prev), Some(&t)) = (out.time_s.last(), part.data.time_s.first()) {
@@ -235,15 +337,15 @@ fn read_imu_in_blocks(
         out.dtheta_rad.extend_from_slice(&part.data.dtheta_rad);
         out.dvel_m_s.extend_from_slice(&part.data.dvel_m_s);
     }
-    Ok(out)
+    Ok(())
 }
 
 /// Target size of the blocks [`read_kfgins_imu`] parses in parallel, bytes.
 const IMU_BLOCK_BYTES: usize = 1 << 22;
 
 /// Splits `text` after newlines into blocks of about `target` bytes, each with the
-/// 1-based number of its first line.
-fn line_blocks(text: &str, target: usize) -> Vec<(usize, &str)> {
+/// 1-based number of its first line (the text's first is `line0`) and its newline count.
+fn line_blocks(text: &str, target: usize, line0: usize) -> Vec<(usize, &str, usize)> {
     use rayon::prelude::*;
     let bytes = text.as_bytes();
     let mut cuts = vec![0];
@@ -265,13 +367,13 @@ fn line_blocks(text: &str, target: usize) -> Vec<(usize, &str)> {
         .par_iter()
         .map(|p| p.bytes().filter(|&b| b == b'\n').count())
         .collect();
-    let mut line0 = 1;
+    let mut line = line0;
     pieces
         .into_iter()
         .zip(newlines)
         .map(|(p, nl)| {
-            let block = (line0, p);
-            line0 += nl;
+            let block = (line, p, nl);
+            line += nl;
             block
         })
         .collect()
@@ -1085,6 +1187,41 @@ mod tests {
                 assert_eq!(e, whole, "block size {block}");
             }
         }
+    }
+
+    /// The file reader's chunks of whole lines give the in-memory result and errors
+    /// (line numbers included) whatever the chunk size.
+    #[test]
+    fn imu_file_chunks_parse_as_one() {
+        let dir = std::env::temp_dir().join(format!("driftless-imu-chunks-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("imu.txt");
+        let name = path.display().to_string();
+        let mut text = String::from("\n  \n");
+        for i in 0..120 {
+            text.push_str(&format!(
+                "{:.3} {} -2e-5 3e-5, 0.001 -0.002 0.049\n",
+                100.0 + 0.005 * i as f64,
+                1e-5 * i as f64
+            ));
+        }
+        let lines: Vec<&str> = text.split('\n').collect();
+        let mut bad = lines.clone();
+        bad[90] = "100.9 x 0 0 0 0 0";
+        let mut bad_utf8 = text.clone().into_bytes();
+        let at = text.match_indices('\n').nth(70).unwrap().0 + 3;
+        bad_utf8[at] = 0xff;
+        for bytes in [text.clone().into_bytes(), bad.join("\n").into_bytes(), bad_utf8] {
+            std::fs::write(&path, &bytes).unwrap();
+            let whole = read_kfgins_imu(&bytes, &name).map_err(|e| e.to_string());
+            for chunk in [2, 5, 64, 1000, 1 << 20] {
+                let r = read_imu_file_chunked(&path, chunk, 100).map_err(|e| e.to_string());
+                assert_eq!(r, whole, "chunk {chunk}");
+            }
+        }
+        let err = read_kfgins_imu(bad.join("\n").as_bytes(), &name).unwrap_err();
+        assert!(err.to_string().contains(&format!("{name}:91:")), "{err}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

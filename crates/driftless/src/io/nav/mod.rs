@@ -48,9 +48,18 @@ pub(crate) fn read_file(path: &std::path::Path) -> Result<Vec<u8>, LogError> {
 
 /// Text of a file as UTF-8, or an error naming the first bad byte's line and column.
 pub(crate) fn as_utf8<'a>(bytes: &'a [u8], name: &str) -> Result<&'a str, LogError> {
+    as_utf8_from(bytes, name, 1)
+}
+
+/// [`as_utf8`] of a piece of a text whose first line is line `line0` of the file.
+pub(crate) fn as_utf8_from<'a>(
+    bytes: &'a [u8],
+    name: &str,
+    line0: usize,
+) -> Result<&'a str, LogError> {
     std::str::from_utf8(bytes).map_err(|e| {
         let good = &bytes[..e.valid_up_to()];
-        let line = good.iter().filter(|&&b| b == b'\n').count() + 1;
+        let line = good.iter().filter(|&&b| b == b'\n').count() + line0;
         let col = good.len() - good.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1) + 1;
         LogError::Malformed {
             at: Location::field(name, line, col),
