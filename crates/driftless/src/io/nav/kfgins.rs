@@ -1025,10 +1025,11 @@ pub fn kfgins_heading_rad(yaw_rad: f64) -> f64 {
     }
 }
 
-/// Creates (truncates) one output file with a 1 MiB buffer.
+/// Creates (truncates) one output file with a 64 KiB buffer: [`write_rows`] hands it
+/// whole chunks, which a buffer smaller than them passes straight to the file.
 fn create_output(p: &Path) -> Result<std::io::BufWriter<std::fs::File>, LogError> {
     std::fs::File::create(p)
-        .map(|f| std::io::BufWriter::with_capacity(1 << 20, f))
+        .map(|f| std::io::BufWriter::with_capacity(1 << 16, f))
         .map_err(|e| io_error(&p.display().to_string(), e))
 }
 
