@@ -14,8 +14,8 @@ use driftless::io::nav::read_kfgins_imu_file;
 use driftless::nav::filter::model::{FilterConfig, GaussMarkov, ImuNoise};
 use driftless::nav::outage::OutageSpec;
 use driftless::nav::pipeline::{
-    GnssOutsideImu, ImuStreamOptions, RateChannels, TaggedCsvOptions,
-    imu_from_kfgins, imu_from_rates_log, imu_from_tagged_csv_files, read_gnss_file, select_gnss,
+    GnssOutsideImu, ImuStreamOptions, RateChannels, TaggedCsvOptions, imu_from_kfgins,
+    imu_from_rates_log, imu_from_tagged_csv_files, read_gnss_file, select_gnss,
 };
 use driftless::nav::session::{SessionConfig, consumer_mems_noise, run_session, solution_records};
 use std::path::PathBuf;
@@ -362,7 +362,11 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
         write_extra_outputs(a, &sol, job.dt_s)?;
     }
     let run = &job.run;
-    let files: Vec<&PathBuf> = job.files.iter().chain(job.smoothed_files.iter().flatten()).collect();
+    let files: Vec<&PathBuf> = job
+        .files
+        .iter()
+        .chain(job.smoothed_files.iter().flatten())
+        .collect();
     if a.json {
         println!(
             "{}",

@@ -230,15 +230,25 @@ fn kf_gins_rows_are_the_imu_epochs_and_yaw_is_0_to_360() {
         // every IMU epoch after the initial one, none added at the fix times
         assert_eq!(r.len(), n - 1, "{f}");
         for (row, t) in r.iter().zip(&imu_times[1..]) {
-            assert!((row[col] - t).abs() < 1e-9, "{f}: row at {} s, IMU epoch {t} s", row[col]);
+            assert!(
+                (row[col] - t).abs() < 1e-9,
+                "{f}: row at {} s, IMU epoch {t} s",
+                row[col]
+            );
         }
     }
     let nav = rows(&dir.join("out/KF_GINS_Navresult.nav"));
     let yaw: Vec<f64> = nav.iter().map(|r| r[10]).collect();
-    assert!(yaw.iter().all(|y| (0.0..360.0).contains(y)), "yaw outside [0, 360)");
+    assert!(
+        yaw.iter().all(|y| (0.0..360.0).contains(y)),
+        "yaw outside [0, 360)"
+    );
     assert!(yaw.iter().any(|&y| y > 355.0) && yaw.iter().any(|&y| y < 5.0));
     let err = nav_row_error_m(&turn, nav.last().unwrap());
-    assert!(err < 0.05, "final horizontal error {err} m with fixes between IMU samples");
+    assert!(
+        err < 0.05,
+        "final horizontal error {err} m with fixes between IMU samples"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -255,8 +265,15 @@ fn kf_gins_fix_at_starttime_is_not_used() {
     run_kf_gins_cli(&dir, &[]);
     let with_bad_fix = std::fs::read(dir.join("out/KF_GINS_Navresult.nav")).unwrap();
     let nav = rows(&dir.join("out/KF_GINS_Navresult.nav"));
-    assert!((nav[0][1] - (T0 + start_s + DT)).abs() < 1e-9, "first row {}", nav[0][1]);
-    let worst = nav.iter().map(|r| nav_row_error_m(&turn, r)).fold(0.0, f64::max);
+    assert!(
+        (nav[0][1] - (T0 + start_s + DT)).abs() < 1e-9,
+        "first row {}",
+        nav[0][1]
+    );
+    let worst = nav
+        .iter()
+        .map(|r| nav_row_error_m(&turn, r))
+        .fold(0.0, f64::max);
     assert!(worst < 0.05, "worst horizontal error {worst} m");
     // The same without that fix: identical output.
     let rest = fixes_at(&turn, T0, (11..30).map(f64::from));
@@ -264,7 +281,10 @@ fn kf_gins_fix_at_starttime_is_not_used() {
     write_kfgins_gnss(file, "gnss.txt", &rest).unwrap();
     run_kf_gins_cli(&dir, &[]);
     let without = std::fs::read(dir.join("out/KF_GINS_Navresult.nav")).unwrap();
-    assert!(with_bad_fix == without, "the fix at starttime changed the output");
+    assert!(
+        with_bad_fix == without,
+        "the fix at starttime changed the output"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -304,7 +324,10 @@ fn kf_gins_outlier_used_without_gate_rejected_with_one() {
     let rejected = nav_at_bad();
     eprintln!("error at the outlier's epoch: {used:.3} m without gate, {rejected:.4} m with");
     assert!(used > 1.0, "outlier not used without gate: {used} m");
-    assert!(rejected < 0.05, "outlier not rejected with the gate: {rejected} m");
+    assert!(
+        rejected < 0.05,
+        "outlier not rejected with the gate: {rejected} m"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -316,12 +339,28 @@ fn kf_gins_smooth_writes_smoothed_files_closer_inside_an_outage() {
     let turn = turn();
     let n = 24_000;
     let bias = ([2e-5, -3e-5, 4e-5], [0.03, -0.02, 0.04]); // ~4–8 °/h, 2–4 mg
-    kfgins_dataset(&dir, &turn, n, 0.0, Some(bias), &turn_fixes(&turn, T0), true);
+    kfgins_dataset(
+        &dir,
+        &turn,
+        n,
+        0.0,
+        Some(bias),
+        &turn_fixes(&turn, T0),
+        true,
+    );
     let (a, b) = (T0 + 60.0, T0 + 100.0);
     let window = format!("@{a}+40");
     let stdout_json = bin()
         .current_dir(&dir)
-        .args(["nav", "--kf-gins", "kf-gins.yaml", "--smooth", "--json", "--outages", &window])
+        .args([
+            "nav",
+            "--kf-gins",
+            "kf-gins.yaml",
+            "--smooth",
+            "--json",
+            "--outages",
+            &window,
+        ])
         .output()
         .unwrap();
     assert!(

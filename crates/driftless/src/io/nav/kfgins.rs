@@ -618,12 +618,18 @@ fn put_value(out: &mut [u8], v: f64) -> Option<usize> {
     let out = &mut out[..VALUE_MAX];
     let mut n = usize::from(v.is_sign_negative());
     out[0] = if n == 1 { b'-' } else { b' ' };
-    let int_digits = int.checked_ilog10().map_or(1, |d| d as usize + 1);
-    // The integer's digits are the last `int_digits` of its eight; the zero bytes shifted
-    // in behind them are overwritten by the point and the fraction.
-    let int_ascii = eight_digits(int as u32) >> (8 * (8 - int_digits));
-    out[n..n + 8].copy_from_slice(&int_ascii.to_le_bytes());
-    n += int_digits;
+    if int < 10 {
+        // One digit (σ's, biases, angles below 10): no digit split needed.
+        out[n] = b'0' + int as u8;
+        n += 1;
+    } else {
+        let int_digits = int.ilog10() as usize + 1;
+        // The integer's digits are the last `int_digits` of its eight; the zero bytes
+        // shifted in behind them are overwritten by the point and the fraction.
+        let int_ascii = eight_digits(int as u32) >> (8 * (8 - int_digits));
+        out[n..n + 8].copy_from_slice(&int_ascii.to_le_bytes());
+        n += int_digits;
+    }
     out[n] = b'.';
     out[n + 1] = b'0' + (frac / 100_000_000) as u8;
     out[n + 2..n + 10].copy_from_slice(&eight_digits((frac % 100_000_000) as u32).to_le_bytes());
@@ -709,8 +715,31 @@ fn write_rows(
     mut row: impl FnMut(usize, &mut Vec<f64>),
 ) -> Result<(), LogError> {
     const CHUNK: usize = 4 << 20;
+    // One chunk buffer per thread, kept between calls: a fresh 4 MiB per block of rows
+    // would be page-faulted (and zeroed by the kernel) anew each time.
+    thread_local! {
+        static SCRATCH: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+    }
+    let mut out = SCRATCH.with(|b| std::mem::take(&mut *b.borrow_mut()));
+    out.clear();
+    out.reserve(CHUNK + 64 * VALUE_MAX);
+    let r = format_rows(w, name, n, first_row, &mut row, &mut out, CHUNK);
+    out.clear();
+    SCRATCH.with(|b| *b.borrow_mut() = out);
+    r
+}
+
+/// [`write_rows`] with its chunk buffer `out`.
+fn format_rows(
+    w: &mut impl Write,
+    name: &str,
+    n: usize,
+    first_row: usize,
+    row: &mut impl FnMut(usize, &mut Vec<f64>),
+    out: &mut Vec<u8>,
+    chunk: usize,
+) -> Result<(), LogError> {
     let mut vals = Vec::with_capacity(22);
-    let mut out: Vec<u8> = Vec::with_capacity(CHUNK + 64 * VALUE_MAX);
     for i in 0..n {
         vals.clear();
         row(i, &mut vals);
@@ -742,12 +771,12 @@ fn write_rows(
         }
         out.truncate(pos);
         out.push(b'\n');
-        if out.len() >= CHUNK {
-            w.write_all(&out).map_err(|error| io_error(name, error))?;
+        if out.len() >= chunk {
+            w.write_all(out).map_err(|error| io_error(name, error))?;
             out.clear();
         }
     }
-    w.write_all(&out).map_err(|error| io_error(name, error))
+    w.write_all(out).map_err(|error| io_error(name, error))
 }
 
 fn io_error(name: &str, error: std::io::Error) -> LogError {
@@ -1212,7 +1241,11 @@ mod tests {
         let mut bad_utf8 = text.clone().into_bytes();
         let at = text.match_indices('\n').nth(70).unwrap().0 + 3;
         bad_utf8[at] = 0xff;
-        for bytes in [text.clone().into_bytes(), bad.join("\n").into_bytes(), bad_utf8] {
+        for bytes in [
+            text.clone().into_bytes(),
+            bad.join("\n").into_bytes(),
+            bad_utf8,
+        ] {
             std::fs::write(&path, &bytes).unwrap();
             let whole = read_kfgins_imu(&bytes, &name).map_err(|e| e.to_string());
             for chunk in [2, 5, 64, 1000, 1 << 20] {

@@ -510,7 +510,8 @@ pub fn run_forward_with(
     // Fixes before the start are skipped; a fix at the start is applied at once.
     while g < ng {
         let tg = gnss.time_s[g];
-        let before = tg < t0 - EPS_T || tg.is_nan() || opts.skip_gnss_until_s.is_some_and(|s| tg <= s);
+        let before =
+            tg < t0 - EPS_T || tg.is_nan() || opts.skip_gnss_until_s.is_some_and(|s| tg <= s);
         if !before {
             break;
         }
