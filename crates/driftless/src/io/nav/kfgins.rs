@@ -594,7 +594,7 @@ const VALUE_MAX: usize = 24;
 /// of 200 Hz data.
 fn put_value(out: &mut [u8], v: f64) -> Option<usize> {
     let a = v.abs();
-    if !(a < 1.0e8) {
+    if a.is_nan() || a >= 1.0e8 {
         return None;
     }
     // Truncation by conversion (exact below 2^53), no libm call; through i64, which
