@@ -89,7 +89,8 @@ pub struct NavArgs {
     #[arg(long, value_name = "FILE")]
     pub geojson: Option<PathBuf>,
     /// Also run the RTS smoother and report its in-outage errors (on by default with
-    /// `--preset drive0708`).
+    /// `--preset drive0708`); with `--kf-gins`, also write its solution as
+    /// `KF_GINS_Navresult_smoothed.nav`, `KF_GINS_IMU_ERR_smoothed.txt`, `KF_GINS_STD_smoothed.txt`.
     #[arg(long)]
     pub smooth: bool,
     /// Machine-readable summary.
