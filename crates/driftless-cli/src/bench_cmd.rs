@@ -343,7 +343,9 @@ fn nav_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
             let cfg_path = dir.join("kf-gins.yaml");
             std::fs::write(&cfg_path, yaml)?;
             let (kbest, kmed) = time_runs(a.runs.min(3), || {
-                crate::nav_cmd::kf_gins_job(&cfg_path, "none", false, false).map(|_| ())
+                driftless::nav::kfgins_job::run_kf_gins_job(&cfg_path, &Default::default())
+                    .map(|_| ())
+                    .map_err(Into::into)
             })?;
             results.push((
                 format!(

@@ -8,15 +8,8 @@
 use anyhow::{Context, Result, bail};
 use clap::{Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
 use driftless::eval::SelectedOutage;
-use driftless::io::nav::kfgins::GnssReadOptions;
-use driftless::io::nav::read_kfgins_imu_file;
 use driftless::nav::config::{KEYS, NavConfig, Override, ValueKind};
-use driftless::nav::filter::model::{FilterConfig, GaussMarkov, ImuNoise};
-use driftless::nav::job::{choose_outages, run_nav_job};
-use driftless::nav::outage::OutageSpec;
-use driftless::nav::pipeline::{
-    GnssOutsideImu, ImuGapPolicy, ImuStreamOptions, imu_from_kfgins, select_gnss,
-};
+use driftless::nav::job::run_nav_job;
 use driftless::nav::session::solution_records;
 use std::path::PathBuf;
 
@@ -154,6 +147,12 @@ impl NavArgs {
     /// The outage specification given as a flag (`--outages`), default `none`.
     pub fn outages_spec(&self) -> &str {
         self.settings.get("outages.spec").unwrap_or("none")
+    }
+    /// `--smooth` given (and not `--smooth=false`).
+    pub fn smooth_flag(&self) -> bool {
+        self.settings
+            .get("filter.smooth")
+            .is_some_and(|v| matches!(v, "true" | "yes" | "on" | "1"))
     }
 }
 
@@ -356,219 +355,78 @@ fn selection_table(sel: &[SelectedOutage]) -> String {
     format!("automatic outages:\n{}", t.render())
 }
 
-/// `--kf-gins CONFIG`: the KF-GINS job, forward filter only (KF-GINS has no smoother).
-/// KF-GINS gives noise per axis; this filter takes one value per sensor, so the worst
-/// axis is used.
+/// `--kf-gins CONFIG`: the KF-GINS job of the library
+/// ([`driftless::nav::kfgins_job::run_kf_gins_job`]: KF-GINS's semantics and files; with
+/// `--smooth` also the smoothed solution's three files).
 fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
-    let job = kf_gins_job(
-        path,
-        a.outages_spec(),
-        true,
-        a.csv.is_some() || a.geojson.is_some(),
-    )?;
-    log_rejections(&job.run, 20);
-    if a.csv.is_some() || a.geojson.is_some() {
-        let (sol, _, _) = solution_records(&job.run);
+    use driftless::nav::kfgins_job::{KfGinsJobOptions, run_kf_gins_job};
+    // No gate unless asked, as in KF-GINS.
+    let gate = match a.settings.get("filter.gate") {
+        None | Some("off") => None,
+        Some(g) => Some(
+            g.parse::<driftless::nav::filter::model::Gate>()
+                .with_context(|| format!("--gate {g}"))?,
+        ),
+    };
+    let opts = KfGinsJobOptions {
+        outages: a.outages_spec().parse().context("--outages")?,
+        gate,
+        smooth: a.smooth_flag(),
+        keep_records: a.csv.is_some() || a.geojson.is_some(),
+    };
+    let job = run_kf_gins_job(path, &opts)?;
+    if !a.quiet {
+        for n in &job.notes {
+            eprintln!("note: {n}");
+        }
+        if let Some(sel) = &job.outage_selection {
+            eprint!("{}", selection_table(sel));
+        }
+    }
+    if !a.quiet {
+        log_rejections(&job.run, if a.verbose { usize::MAX } else { 20 });
+    }
+    if let Some((sol, _, _)) = (a.csv.is_some() || a.geojson.is_some())
+        .then(|| job.solution())
+        .flatten()
+    {
         write_extra_outputs(a, &sol, job.dt_s)?;
     }
-    let (run, files) = (&job.run, &job.files);
+    let run = &job.run;
+    let files: Vec<&PathBuf> = job
+        .files
+        .iter()
+        .chain(job.smoothed_files.iter().flatten())
+        .collect();
     if a.json {
         println!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
-                "epochs": run.first_epoch + run.epochs.len(),
+                "epochs": job.rows,
+                "start_time_s": job.start_time_s,
                 "gnss_accepted": run.gnss_accepted,
                 "gnss_rejected": run.gnss_rejected,
                 "gnss_withheld": run.gnss_withheld,
+                "gnss_skipped": run.gnss_skipped,
                 "outputs": files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
             }))?
         );
     } else {
         println!(
-            "{}: {} epochs from {:.3} s, GNSS {} accepted, {} rejected, {} withheld",
+            "{}: {} epochs written from {:.3} s, GNSS {} accepted, {} rejected, {} withheld, {} skipped",
             path.display(),
-            run.first_epoch + run.epochs.len(),
+            job.rows,
             job.start_time_s,
             run.gnss_accepted,
             run.gnss_rejected,
-            run.gnss_withheld
+            run.gnss_withheld,
+            run.gnss_skipped
         );
         for f in files {
             println!("wrote {}", f.display());
         }
     }
     Ok(())
-}
-
-/// What a `--kf-gins` job produced.
-pub struct KfGinsJob {
-    pub run: driftless::nav::filter::run::ForwardRun,
-    pub files: [PathBuf; 3],
-    pub start_time_s: f64,
-    pub dt_s: f64,
-}
-
-/// Read a KF-GINS configuration and its files, run the forward filter, write KF-GINS's
-/// three output files.
-pub fn kf_gins_job(
-    path: &std::path::Path,
-    outages: &str,
-    verbose: bool,
-    keep_records: bool,
-) -> Result<KfGinsJob> {
-    use driftless::io::nav::{KfGinsConfig, read_kfgins_gnss_file};
-    use driftless::nav::attitude::Euler;
-    use driftless::nav::filter::run::{EpochRecord, InitialState, run_forward_observed};
-    use driftless::nav::filter::state::SensorErrors;
-    use driftless::nav::mechanization::NavState;
-    use driftless::nav::session::epoch_solution_records;
-    let k = KfGinsConfig::from_file(path)?;
-    if verbose {
-        for key in &k.unknown_keys {
-            eprintln!(
-                "note: {}: key `{key}` is not used by KF-GINS and is ignored",
-                path.display()
-            );
-        }
-    }
-    let inc = read_kfgins_imu_file(&k.imu_path)?;
-    // KF-GINS integrates across missing IMU samples; so does this job, and says so.
-    let imu = imu_from_kfgins(
-        &inc,
-        &k.imu_path.display().to_string(),
-        &ImuStreamOptions {
-            gap_policy: ImuGapPolicy::Bridge,
-            ..ImuStreamOptions::default()
-        },
-    )?;
-    if verbose {
-        for g in imu.gaps.iter().take(20) {
-            eprintln!(
-                "note: {}: IMU gap of {:.4} s before t = {:.4} s (epoch {}): integrated across, as KF-GINS does",
-                k.imu_path.display(),
-                g.gap_s,
-                g.time_s,
-                g.index + 1
-            );
-        }
-        if imu.gaps.len() > 20 {
-            eprintln!("note: … {} more IMU gaps", imu.gaps.len() - 20);
-        }
-    }
-    let gnss = read_kfgins_gnss_file(&k.gnss_path, &GnssReadOptions::default())?;
-    let max3 = |v: [f64; 3]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let n = &k.imu_noise;
-    let gm = |sigma: [f64; 3]| GaussMarkov {
-        sigma: max3(sigma),
-        tau_s: n.corr_time_s,
-    };
-    let noise = ImuNoise {
-        gyro_arw_rad_sqrt_s: max3(n.arw_rad_sqrt_s),
-        accel_vrw_m_s_sqrt_s: max3(n.vrw_m_s_sqrt_s),
-        gyro_bias: gm(n.gyro_bias_std_rad_s),
-        accel_bias: gm(n.accel_bias_std_m_s2),
-        gyro_scale: gm(n.gyro_scale_std),
-        accel_scale: gm(n.accel_scale_std),
-    };
-    let mut cfg = FilterConfig::new(noise, k.antenna_lever_frd_m);
-    if let Some(longest) = imu.gaps.iter().map(|g| g.gap_s).reduce(f64::max) {
-        cfg.max_gap_factor = cfg.max_gap_factor.max(1.01 * longest / imu.nominal_dt_s);
-    }
-    let spec: OutageSpec = outages.parse().context("--outages")?;
-    if spec != OutageSpec::None {
-        let in_span = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)?;
-        let (spec, selection) = choose_outages(spec, &in_span.fixes)?;
-        if let (true, Some(sel)) = (verbose, &selection) {
-            eprint!("{}", selection_table(sel));
-        }
-        let sel = select_gnss(&gnss, &imu, &spec, GnssOutsideImu::Drop)?;
-        cfg.outages_s = sel.windows.iter().map(|w| (w.start_s, w.end_s)).collect();
-    }
-    let [r, p, y] = k.init_roll_pitch_yaw_rad;
-    let nav = NavState {
-        time_s: k.start_time_s,
-        lat_rad: k.init_lat_rad,
-        lon_rad: k.init_lon_rad,
-        height_m: k.init_height_m,
-        vel_ned_m_s: k.init_vel_ned_m_s,
-        q_bn: Euler {
-            roll_rad: r,
-            pitch_rad: p,
-            yaw_rad: y,
-        }
-        .to_quat(),
-    };
-    let cat = |a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]| {
-        let mut s = [0.0; 12];
-        s[..3].copy_from_slice(&a);
-        s[3..6].copy_from_slice(&b);
-        s[6..9].copy_from_slice(&c);
-        s[9..].copy_from_slice(&d);
-        s
-    };
-    let init = InitialState {
-        nav,
-        sensors: SensorErrors {
-            gyro_bias_rad_s: k.init_gyro_bias_rad_s,
-            accel_bias_m_s2: k.init_accel_bias_m_s2,
-            gyro_scale: k.init_gyro_scale,
-            accel_scale: k.init_accel_scale,
-        },
-        sigma_pos_ned_m: k.init_pos_std_ned_m,
-        sigma_vel_ned_m_s: k.init_vel_std_ned_m_s,
-        sigma_att_rad: k.init_att_std_rad,
-        sigma_sensors: Some(cat(
-            k.init_gyro_bias_std_rad_s,
-            k.init_accel_bias_std_m_s2,
-            k.init_gyro_scale_std,
-            k.init_accel_scale_std,
-        )),
-    };
-    let end = k.end_time_s.unwrap_or(f64::INFINITY);
-    let n_end = imu.epochs.partition_point(|e| e.time_s <= end);
-    std::fs::create_dir_all(&k.output_dir)
-        .with_context(|| format!("creating {}", k.output_dir.display()))?;
-    // The filter runs on this thread; the output files are created (truncating an
-    // earlier run's), formatted and written on another from the blocks of epoch
-    // records the filter hands out. The records are not kept (no smoother here), except
-    // when --csv / --geojson need the whole solution.
-    let keep = keep_records;
-    let out_dir = k.output_dir.clone();
-    let (run, files) = std::thread::scope(|scope| -> Result<_> {
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<EpochRecord>>(8);
-        let formatter = scope.spawn(move || -> Result<[PathBuf; 3]> {
-            let mut writer = driftless::io::nav::KfGinsOutputWriter::create(&out_dir, 0)?;
-            for block in rx {
-                let (sol, err, std) = epoch_solution_records(&block);
-                writer.append(&sol, &err, &std)?;
-            }
-            Ok(writer.finish()?)
-        });
-        let run = run_forward_observed(
-            &imu.epochs[..n_end],
-            &gnss,
-            init,
-            &cfg,
-            &mut |b| {
-                // A send fails only when the formatter has stopped on an error, which
-                // `join` reports below.
-                let _ = tx.send(b.to_vec());
-            },
-            keep,
-        );
-        drop(tx);
-        let files = formatter
-            .join()
-            .map_err(|_| anyhow::anyhow!("the output writer thread panicked"))?;
-        let run = run?;
-        Ok((run, files?))
-    })?;
-    Ok(KfGinsJob {
-        run,
-        files,
-        start_time_s: k.start_time_s,
-        dt_s: imu.nominal_dt_s,
-    })
 }
 
 /// `--csv` and `--geojson`.
@@ -592,7 +450,7 @@ fn write_extra_outputs(
     Ok(())
 }
 
-/// Log the measurements the χ² gate rejected (stderr; at most `max` lines).
+/// Log the measurements the gate rejected (stderr; at most `max` lines).
 fn log_rejections(run: &driftless::nav::filter::run::ForwardRun, max: usize) {
     let mut n = 0usize;
     for o in run.rejections() {

@@ -22,12 +22,12 @@ fn turn() -> ConstantTurn {
     }
 }
 
-/// 1 Hz fixes of the turn's exact positions from `t0 + 1` to `t0 + 119` s, 2 cm σ labels.
-fn turn_fixes(turn: &ConstantTurn, t0: f64) -> GnssFixes {
+/// Fixes of the turn's exact positions at `t0 + s` for each `s`, 2 cm σ labels.
+fn fixes_at(turn: &ConstantTurn, t0: f64, times: impl IntoIterator<Item = f64>) -> GnssFixes {
     let mut gnss = GnssFixes::default();
-    for s in 1..120 {
-        let p = turn.point(s as f64);
-        gnss.time_s.push(t0 + s as f64);
+    for s in times {
+        let p = turn.point(s);
+        gnss.time_s.push(t0 + s);
         gnss.lat_rad.push(p.lat_rad);
         gnss.lon_rad.push(p.lon_rad);
         gnss.height_m.push(p.height_m);
@@ -37,30 +37,58 @@ fn turn_fixes(turn: &ConstantTurn, t0: f64) -> GnssFixes {
     gnss
 }
 
-#[test]
-fn kf_gins_config_runs_unchanged_and_writes_its_three_files() {
-    let dir = std::env::temp_dir().join(format!("driftless-kfgins-{}", std::process::id()));
+/// 1 Hz fixes of the turn's exact positions from `t0 + 1` to `t0 + 119` s.
+fn turn_fixes(turn: &ConstantTurn, t0: f64) -> GnssFixes {
+    fixes_at(turn, t0, (1..120).map(f64::from))
+}
+
+/// GPS seconds of week of the synthetic datasets.
+const T0: f64 = 356_400.0;
+/// IMU interval of the synthetic datasets, s.
+const DT: f64 = 0.005;
+
+/// A synthetic KF-GINS dataset in `dir`: ideal 200 Hz increments of `turn` (plus a
+/// constant gyro bias [rad/s] and accelerometer bias [m/s²] when given) ending at
+/// T0 + k·DT for k = 1..=n, the fixes `gnss`, and `kf-gins.yaml` whose initial state is
+/// the truth at `start_s` after T0 (starttime T0 + start_s). Paths in the YAML are
+/// `./data/…` and `./out` with `relative`, else absolute.
+fn kfgins_dataset(
+    dir: &std::path::Path,
+    turn: &ConstantTurn,
+    n: usize,
+    start_s: f64,
+    bias: Option<([f64; 3], [f64; 3])>,
+    gnss: &GnssFixes,
+    relative: bool,
+) {
     std::fs::create_dir_all(dir.join("data")).unwrap();
-    let t0 = 356_400.0; // GPS seconds of week
-    let turn = turn();
-    let dt = 0.005;
-    let n = 24_000; // 120 s at 200 Hz
-    let incs: Vec<_> = ideal_increments(&turn, dt, dt, n).collect();
+    let incs: Vec<_> = ideal_increments(turn, DT, DT, n).collect();
+    let (bg, ba) = bias.unwrap_or(([0.0; 3], [0.0; 3]));
     let imu = ImuIncrements {
-        time_s: (0..n).map(|k| t0 + (k + 1) as f64 * dt).collect(),
-        dtheta_rad: incs.iter().map(|i| i.dtheta_rad).collect(),
-        dvel_m_s: incs.iter().map(|i| i.dvel_m_s).collect(),
+        time_s: (0..n).map(|k| T0 + (k + 1) as f64 * DT).collect(),
+        dtheta_rad: incs
+            .iter()
+            .map(|i| std::array::from_fn(|a| i.dtheta_rad[a] + bg[a] * DT))
+            .collect(),
+        dvel_m_s: incs
+            .iter()
+            .map(|i| std::array::from_fn(|a| i.dvel_m_s[a] + ba[a] * DT))
+            .collect(),
         ..Default::default()
     };
-    let gnss = turn_fixes(&turn, t0);
     let file = |p: &str| std::fs::File::create(dir.join(p)).unwrap();
     write_kfgins_imu(file("data/imu.txt"), "imu.txt", &imu).unwrap();
-    write_kfgins_gnss(file("data/gnss.txt"), "gnss.txt", &gnss).unwrap();
-    let p0 = turn.point(0.0);
+    write_kfgins_gnss(file("data/gnss.txt"), "gnss.txt", gnss).unwrap();
+    let p0 = turn.point(start_s);
     let e0 = Euler::from_dcm(&p0.c_bn);
+    let root = if relative {
+        ".".to_string()
+    } else {
+        dir.display().to_string()
+    };
     let cfg = format!(
-        "imupath: \"./data/imu.txt\"\ngnsspath: \"./data/gnss.txt\"\noutputpath: \"./out\"\n\
-         imudatalen: 7\nimudatarate: 200\nstarttime: {t0}\nendtime: -1\n\
+        "imupath: \"{root}/data/imu.txt\"\ngnsspath: \"{root}/data/gnss.txt\"\noutputpath: \"{root}/out\"\n\
+         imudatalen: 7\nimudatarate: 200\nstarttime: {}\nendtime: -1\n\
          initpos: [{}, {}, {}]\ninitvel: [{}, {}, {}]\ninitatt: [{}, {}, {}]\n\
          initgyrbias: [0, 0, 0]\ninitaccbias: [0, 0, 0]\ninitgyrscale: [0, 0, 0]\n\
          initaccscale: [0, 0, 0]\ninitposstd: [0.05, 0.05, 0.05]\ninitvelstd: [0.05, 0.05, 0.05]\n\
@@ -69,6 +97,7 @@ fn kf_gins_config_runs_unchanged_and_writes_its_three_files() {
          \x20 abstd: [1000.0, 1000.0, 1000.0]\n  gsstd: [1000.0, 1000.0, 1000.0]\n\
          \x20 asstd: [1000.0, 1000.0, 1000.0]\n  corrtime: 1.0\n\
          antlever: [0.0, 0.0, 0.0]\n",
+        T0 + start_s,
         p0.lat_rad.to_degrees(),
         p0.lon_rad.to_degrees(),
         p0.height_m,
@@ -80,7 +109,53 @@ fn kf_gins_config_runs_unchanged_and_writes_its_three_files() {
         e0.yaw_rad.to_degrees(),
     );
     std::fs::write(dir.join("kf-gins.yaml"), cfg).unwrap();
+}
 
+/// The rows of a KF-GINS output file, as numbers.
+fn rows(path: &std::path::Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
+
+/// Horizontal distance of a `.nav` row (time, lat, lon in deg in columns 2–4) from the
+/// turn's truth, m.
+fn nav_row_error_m(turn: &ConstantTurn, row: &[f64]) -> f64 {
+    let truth = turn.point(row[1] - T0);
+    let d_n = (row[2].to_radians() - truth.lat_rad) * 6_378_137.0;
+    let d_e = (row[3].to_radians() - truth.lon_rad) * 6_378_137.0 * truth.lat_rad.cos();
+    d_n.hypot(d_e)
+}
+
+/// A fresh scratch folder for one test.
+fn scratch(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("driftless-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs `driftless nav --kf-gins kf-gins.yaml` plus `extra` in `dir`; must succeed.
+fn run_kf_gins_cli(dir: &std::path::Path, extra: &[&str]) -> String {
+    let out = bin()
+        .current_dir(dir)
+        .args(["nav", "--kf-gins", "kf-gins.yaml"])
+        .args(extra)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{stderr}");
+    stderr
+}
+
+#[test]
+fn kf_gins_config_runs_unchanged_and_writes_its_three_files() {
+    let dir = scratch("kfgins");
+    let turn = turn();
+    kfgins_dataset(&dir, &turn, 24_000, 0.0, None, &turn_fixes(&turn, T0), true);
+    let t0 = T0;
     let out = bin()
         .current_dir(&dir)
         .args(["nav", "--kf-gins", "kf-gins.yaml"])
@@ -99,21 +174,12 @@ fn kf_gins_config_runs_unchanged_and_writes_its_three_files() {
         assert!(dir.join("out").join(f).exists(), "{f} missing");
     }
     // Last navigation line: week, time, lat, lon, h, vN, vE, vD, roll, pitch, yaw.
-    let nav = std::fs::read_to_string(dir.join("out/KF_GINS_Navresult.nav")).unwrap();
-    let last: Vec<f64> = nav
-        .lines()
-        .last()
-        .unwrap()
-        .split_whitespace()
-        .map(|v| v.parse().unwrap())
-        .collect();
+    let nav = rows(&dir.join("out/KF_GINS_Navresult.nav"));
+    let last = nav.last().unwrap();
     assert_eq!(last.len(), 11);
     let t_end = last[1] - t0;
     assert!((t_end - 120.0).abs() < 0.01, "ends at {t_end} s");
-    let truth = turn.point(t_end);
-    let d_n = (last[2].to_radians() - truth.lat_rad) * 6_378_137.0;
-    let d_e = (last[3].to_radians() - truth.lon_rad) * 6_378_137.0 * truth.lat_rad.cos();
-    let err = d_n.hypot(d_e);
+    let err = nav_row_error_m(&turn, last);
     eprintln!("--kf-gins: final horizontal error {err:.4} m after 120 s");
     assert!(err < 0.05, "final horizontal error {err} m");
 
@@ -127,17 +193,205 @@ fn kf_gins_config_runs_unchanged_and_writes_its_three_files() {
         .map(|(_, l)| l)
         .collect();
     std::fs::write(dir.join("data/imu.txt"), kept.join("\n")).unwrap();
-    let out = bin()
-        .current_dir(&dir)
-        .args(["nav", "--kf-gins", "kf-gins.yaml"])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let stderr = run_kf_gins_cli(&dir, &[]);
     assert!(
         stderr.contains("IMU gap of 0.0200 s") && stderr.contains("as KF-GINS does"),
         "{stderr}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// KF-GINS writes one row per IMU epoch after the start, at the IMU time stamps, also
+/// when the fixes fall between IMU samples (it interpolates, updates, and writes the
+/// state at the IMU epoch), and gives yaw in [0°, 360°): a turn through north
+/// (350° → 30°) with fixes 2.5 ms after each second.
+#[test]
+fn kf_gins_rows_are_the_imu_epochs_and_yaw_is_0_to_360() {
+    let dir = scratch("kfgins-rows");
+    let turn = ConstantTurn {
+        yaw0_rad: 350f64.to_radians(),
+        ..turn()
+    };
+    let n = 4_000; // 20 s
+    let gnss = fixes_at(&turn, T0, (1..20).map(|s| f64::from(s) + 0.0025));
+    // starttime on the first IMU epoch, as KF-GINS requires
+    kfgins_dataset(&dir, &turn, n, DT, None, &gnss, true);
+    run_kf_gins_cli(&dir, &[]);
+    let imu_times: Vec<f64> = rows(&dir.join("data/imu.txt"))
+        .iter()
+        .map(|r| r[0])
+        .collect();
+    for f in [
+        "KF_GINS_Navresult.nav",
+        "KF_GINS_IMU_ERR.txt",
+        "KF_GINS_STD.txt",
+    ] {
+        let r = rows(&dir.join("out").join(f));
+        let col = usize::from(f.ends_with(".nav"));
+        // every IMU epoch after the initial one, none added at the fix times
+        assert_eq!(r.len(), n - 1, "{f}");
+        for (row, t) in r.iter().zip(&imu_times[1..]) {
+            assert!(
+                (row[col] - t).abs() < 1e-9,
+                "{f}: row at {} s, IMU epoch {t} s",
+                row[col]
+            );
+        }
+    }
+    let nav = rows(&dir.join("out/KF_GINS_Navresult.nav"));
+    let yaw: Vec<f64> = nav.iter().map(|r| r[10]).collect();
+    assert!(
+        yaw.iter().all(|y| (0.0..360.0).contains(y)),
+        "yaw outside [0, 360)"
+    );
+    assert!(yaw.iter().any(|&y| y > 355.0) && yaw.iter().any(|&y| y < 5.0));
+    let err = nav_row_error_m(&turn, nav.last().unwrap());
+    assert!(
+        err < 0.05,
+        "final horizontal error {err} m with fixes between IMU samples"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// KF-GINS updates only with fixes strictly after `starttime`: a fix exactly at
+/// starttime, 50 m off, changes nothing.
+#[test]
+fn kf_gins_fix_at_starttime_is_not_used() {
+    let dir = scratch("kfgins-start");
+    let turn = turn();
+    let start_s = 10.0;
+    let mut gnss = fixes_at(&turn, T0, (10..30).map(f64::from));
+    gnss.lat_rad[0] += 50.0 / 6_378_137.0;
+    kfgins_dataset(&dir, &turn, 6_000, start_s, None, &gnss, true);
+    run_kf_gins_cli(&dir, &[]);
+    let with_bad_fix = std::fs::read(dir.join("out/KF_GINS_Navresult.nav")).unwrap();
+    let nav = rows(&dir.join("out/KF_GINS_Navresult.nav"));
+    assert!(
+        (nav[0][1] - (T0 + start_s + DT)).abs() < 1e-9,
+        "first row {}",
+        nav[0][1]
+    );
+    let worst = nav
+        .iter()
+        .map(|r| nav_row_error_m(&turn, r))
+        .fold(0.0, f64::max);
+    assert!(worst < 0.05, "worst horizontal error {worst} m");
+    // The same without that fix: identical output.
+    let rest = fixes_at(&turn, T0, (11..30).map(f64::from));
+    let file = std::fs::File::create(dir.join("data/gnss.txt")).unwrap();
+    write_kfgins_gnss(file, "gnss.txt", &rest).unwrap();
+    run_kf_gins_cli(&dir, &[]);
+    let without = std::fs::read(dir.join("out/KF_GINS_Navresult.nav")).unwrap();
+    assert!(
+        with_bad_fix == without,
+        "the fix at starttime changed the output"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Without a gate a gross outlier is used, as in KF-GINS; with an explicit χ² gate it
+/// is rejected (library job options).
+#[test]
+fn kf_gins_outlier_used_without_gate_rejected_with_one() {
+    use driftless::nav::kfgins_job::{KfGinsJobOptions, run_kf_gins_job};
+    let dir = scratch("kfgins-gate");
+    let turn = turn();
+    let mut gnss = fixes_at(&turn, T0, (1..60).map(f64::from));
+    let bad = 30;
+    gnss.lat_rad[bad - 1] += 30.0 / 6_378_137.0;
+    kfgins_dataset(&dir, &turn, 12_000, 0.0, None, &gnss, false);
+    let cfg = dir.join("kf-gins.yaml");
+    let nav_at_bad = || {
+        let nav = rows(&dir.join("out/KF_GINS_Navresult.nav"));
+        let row = nav
+            .iter()
+            .find(|r| (r[1] - (T0 + bad as f64)).abs() < 1e-6)
+            .unwrap()
+            .clone();
+        nav_row_error_m(&turn, &row)
+    };
+    let plain = run_kf_gins_job(&cfg, &KfGinsJobOptions::default()).unwrap();
+    assert_eq!((plain.run.gnss_accepted, plain.run.gnss_rejected), (59, 0));
+    let used = nav_at_bad();
+    let gated = run_kf_gins_job(
+        &cfg,
+        &KfGinsJobOptions {
+            gate: Some(driftless::nav::filter::model::Gate::Chi2 { p: 0.9999 }),
+            ..KfGinsJobOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!((gated.run.gnss_accepted, gated.run.gnss_rejected), (58, 1));
+    let rejected = nav_at_bad();
+    eprintln!("error at the outlier's epoch: {used:.3} m without gate, {rejected:.4} m with");
+    assert!(used > 1.0, "outlier not used without gate: {used} m");
+    assert!(
+        rejected < 0.05,
+        "outlier not rejected with the gate: {rejected} m"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--smooth` writes the smoothed solution in KF-GINS's formats beside the forward files,
+/// on the same rows, and inside a GNSS outage it is closer to the truth.
+#[test]
+fn kf_gins_smooth_writes_smoothed_files_closer_inside_an_outage() {
+    let dir = scratch("kfgins-smooth");
+    let turn = turn();
+    let n = 24_000;
+    let bias = ([2e-5, -3e-5, 4e-5], [0.03, -0.02, 0.04]); // ~4–8 °/h, 2–4 mg
+    kfgins_dataset(
+        &dir,
+        &turn,
+        n,
+        0.0,
+        Some(bias),
+        &turn_fixes(&turn, T0),
+        true,
+    );
+    let (a, b) = (T0 + 60.0, T0 + 100.0);
+    let window = format!("@{a}+40");
+    let stdout_json = bin()
+        .current_dir(&dir)
+        .args([
+            "nav",
+            "--kf-gins",
+            "kf-gins.yaml",
+            "--smooth",
+            "--json",
+            "--outages",
+            &window,
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        stdout_json.status.success(),
+        "{}",
+        String::from_utf8_lossy(&stdout_json.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&stdout_json.stdout).unwrap();
+    assert_eq!(v["outputs"].as_array().unwrap().len(), 6, "{v}");
+    assert_eq!(v["gnss_withheld"].as_u64(), Some(41), "{v}");
+    let fwd = rows(&dir.join("out/KF_GINS_Navresult.nav"));
+    let sm = rows(&dir.join("out/KF_GINS_Navresult_smoothed.nav"));
+    for f in ["KF_GINS_IMU_ERR_smoothed.txt", "KF_GINS_STD_smoothed.txt"] {
+        assert_eq!(rows(&dir.join("out").join(f)).len(), fwd.len(), "{f}");
+    }
+    assert_eq!(sm.len(), fwd.len());
+    assert_eq!(fwd.len(), n);
+    let max_in = |r: &[Vec<f64>]| {
+        r.iter()
+            .filter(|row| row[1] > a && row[1] < b)
+            .map(|row| nav_row_error_m(&turn, row))
+            .fold(0.0, f64::max)
+    };
+    for (x, y) in fwd.iter().zip(&sm) {
+        assert!((x[1] - y[1]).abs() < 1e-9);
+    }
+    let (e_fwd, e_sm) = (max_in(&fwd), max_in(&sm));
+    eprintln!("40-s outage: max horizontal error forward {e_fwd:.3} m, smoothed {e_sm:.4} m");
+    assert!(e_fwd > 0.05, "the outage should show drift: {e_fwd} m");
+    assert!(e_sm < 0.5 * e_fwd, "smoothed {e_sm} m vs forward {e_fwd} m");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

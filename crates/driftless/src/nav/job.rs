@@ -12,7 +12,7 @@ use crate::io::nav::kfgins::GnssReadOptions;
 use crate::nav::config::{ConfigError, KeyError, LoadedConfig};
 use crate::nav::filter::aids::{NhcConfig, StandstillConfig};
 use crate::nav::filter::model::{FilterConfig, ImuNoise};
-use crate::nav::outage::{OutageItem, OutageSpec, OutageStart};
+use crate::nav::outage::OutageSpec;
 use crate::nav::pipeline::{
     GnssOutsideImu, ImuStream, PipelineError, RateChannels, TaggedCsvOptions, imu_from_kfgins,
     imu_from_rates_log, imu_from_tagged_csv_files, read_gnss_file, select_gnss, subset_fixes,
@@ -418,18 +418,5 @@ pub fn choose_outages(
     spec: OutageSpec,
     fixes: &GnssFixes,
 ) -> Result<(OutageSpec, Option<Vec<SelectedOutage>>), NavJobError> {
-    if !matches!(spec, OutageSpec::Auto { .. }) {
-        return Ok((spec, None));
-    }
-    let reference = crate::eval::reference::reference_from_fixes(fixes)?;
-    let sel =
-        crate::eval::resolve_outages(&spec, &reference, &crate::eval::SelectOptions::default())?;
-    let items = sel
-        .iter()
-        .map(|s| OutageItem {
-            start: OutageStart::Gps(s.window.start_s),
-            length_s: s.window.duration_s(),
-        })
-        .collect();
-    Ok((OutageSpec::Windows(items), Some(sel)))
+    Ok(crate::nav::kfgins_job::resolve_auto_outages(spec, fixes)?)
 }

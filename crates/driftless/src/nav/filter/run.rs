@@ -10,7 +10,10 @@
 //! remainder (1 − α); the filter predicts to t_g, updates, and continues (the same
 //! first-order interpolation KF-GINS and Shin 2005 use; the two-sample corrections of
 //! the split parts see the preceding part as their previous increment). Fixes within
-//! 1 µs of an epoch are applied at the epoch. Fixes inside an outage window
+//! 1 µs of an epoch are applied at the epoch. The record of each split point is listed in
+//! [`ForwardRun::split_points`]; [`RunOptions::observe_split_points`] false hands an
+//! observer only the whole-epoch records (one per IMU epoch, as KF-GINS writes them).
+//! Fixes inside an outage window
 //! ([`FilterConfig::outages_s`], half-open (start, end]) are withheld; fixes before the
 //! initial state or out of order are skipped and counted, and so are fixes whose quality
 //! flag is not in [`FilterConfig::accept_quality`] (when that is not empty). Each fix's σ
@@ -205,6 +208,10 @@ pub struct ForwardRun {
     /// `epochs` holds only the last record and `epoch_index` values count from the
     /// start of the run.
     pub first_epoch: usize,
+    /// Indices in the whole run (like `epoch_index`) of the records at GNSS split points:
+    /// the prediction steps that end at a fix time strictly between two IMU epochs. All
+    /// other records after the first are at IMU epochs.
+    pub split_points: Vec<usize>,
     /// −1/T of the sensor states (to rebuild Φ).
     neg_inv_tau: [f64; 12],
 }
@@ -498,6 +505,84 @@ pub fn run_forward_observed(
     observer: &mut dyn FnMut(&[EpochRecord]),
     keep_epochs: bool,
 ) -> Result<ForwardRun, NavError> {
+    let opts = RunOptions {
+        keep_epochs,
+        ..RunOptions::default()
+    };
+    run_forward_with(imu, gnss, init, cfg, &opts, observer)
+}
+
+/// How [`run_forward_with`] stores and hands out its records, and which fixes it skips.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunOptions {
+    /// Keep every record in [`ForwardRun::epochs`] (default true; the smoother needs
+    /// them). False: records are dropped once observed ([`ForwardRun::first_epoch`]).
+    pub keep_epochs: bool,
+    /// Hand the records at GNSS split points ([`ForwardRun::split_points`]) to the
+    /// observer too (default true). False: the observer sees the initial record and one
+    /// record per IMU epoch — the state after any update at or before that epoch, as a
+    /// filter that writes one row per IMU epoch reports it; the split records are still
+    /// kept in `epochs` when `keep_epochs` is set.
+    pub observe_split_points: bool,
+    /// Skip (count in [`ForwardRun::gnss_skipped`]) every fix at or before this time, s.
+    /// `None` (default): fixes before the initial time are skipped and a fix at the
+    /// initial time is applied at once. KF-GINS updates only with fixes strictly after
+    /// its `starttime`: `Some(starttime)`.
+    pub skip_gnss_until_s: Option<f64>,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            keep_epochs: true,
+            observe_split_points: true,
+            skip_gnss_until_s: None,
+        }
+    }
+}
+
+/// Hands `epochs[from..to]` to the observer, leaving out the split-point records when
+/// `with_splits` is false (`splits`: whole-run indices, increasing; `first`: the
+/// whole-run index of `epochs[0]`).
+fn observe(
+    observer: &mut dyn FnMut(&[EpochRecord]),
+    epochs: &[EpochRecord],
+    (from, to): (usize, usize),
+    first: usize,
+    splits: &[usize],
+    with_splits: bool,
+) {
+    if with_splits {
+        observer(&epochs[from..to]);
+        return;
+    }
+    let lo = splits.partition_point(|&k| k < first + from);
+    let mut a = from;
+    for &k in splits[lo..].iter().take_while(|&&k| k < first + to) {
+        let k = k - first;
+        if k > a {
+            observer(&epochs[a..k]);
+        }
+        a = k + 1;
+    }
+    if to > a {
+        observer(&epochs[a..to]);
+    }
+}
+
+/// The forward pass of [`run_forward`] with [`RunOptions`], handing the records to
+/// `observer` as [`run_forward_observed`] does (each exactly once, in order, once final;
+/// without split points when [`RunOptions::observe_split_points`] is false, so then in
+/// runs between the left-out records).
+pub fn run_forward_with(
+    imu: &[ImuIncrement],
+    gnss: &GnssFixes,
+    init: InitialState,
+    cfg: &FilterConfig,
+    opts: &RunOptions,
+    observer: &mut dyn FnMut(&[EpochRecord]),
+) -> Result<ForwardRun, NavError> {
+    let keep_epochs = opts.keep_epochs;
     cfg.validate()?;
     check_gnss(gnss)?;
     let t0 = init.nav.time_s;
@@ -537,6 +622,7 @@ pub fn run_forward_observed(
                 2 * OBSERVER_BLOCK
             }),
             first_epoch: 0,
+            split_points: Vec::new(),
             updates: Vec::new(),
             gnss_withheld: 0,
             gnss_skipped: 0,
@@ -567,7 +653,9 @@ pub fn run_forward_observed(
     let mut g = 0;
     // Fixes before the start are skipped; a fix at the start is applied at once.
     while g < ng {
-        let before = gnss.time_s[g] < t0 - EPS_T || gnss.time_s[g].is_nan();
+        let tg = gnss.time_s[g];
+        let before =
+            tg < t0 - EPS_T || tg.is_nan() || opts.skip_gnss_until_s.is_some_and(|s| tg <= s);
         if !before {
             break;
         }
@@ -651,6 +739,8 @@ pub fn run_forward_observed(
                 ctx.run
                     .epochs
                     .push(record(&f, f.last_compensated().unwrap_or(first)));
+                let idx = ctx.run.first_epoch + ctx.run.epochs.len() - 1;
+                ctx.run.split_points.push(idx);
                 t_start = tg;
             }
             ctx.apply_fix(&mut f, g)?;
@@ -670,7 +760,15 @@ pub fn run_forward_observed(
         // Only the newest record can still change (updates at its epoch).
         let settled = ctx.run.epochs.len() - 1;
         if settled - observed >= OBSERVER_BLOCK {
-            observer(&ctx.run.epochs[observed..settled]);
+            let r = &ctx.run;
+            observe(
+                observer,
+                &r.epochs,
+                (observed, settled),
+                r.first_epoch,
+                &r.split_points,
+                opts.observe_split_points,
+            );
             observed = settled;
             if !keep_epochs {
                 ctx.run.epochs.drain(..settled);
@@ -679,7 +777,15 @@ pub fn run_forward_observed(
             }
         }
     }
-    observer(&ctx.run.epochs[observed..]);
+    let r = &ctx.run;
+    observe(
+        observer,
+        &r.epochs,
+        (observed, r.epochs.len()),
+        r.first_epoch,
+        &r.split_points,
+        opts.observe_split_points,
+    );
     ctx.run.gnss_skipped += ng - g;
     if let Some(d) = aids.detector {
         ctx.run.standstills = d.finish();
