@@ -403,6 +403,7 @@ fn stream(imu: &[ImuIncrement]) -> ImuStream {
         nominal_dt_s: DT,
         epochs: imu.to_vec(),
         gaps: Vec::new(),
+        notes: Vec::new(),
     }
 }
 

@@ -905,7 +905,16 @@ impl NavConfig {
             .gate
             .trim()
             .parse::<Gate>()
-            .map_err(|e| key_err("filter.gate", e.to_string()))
+            .map_err(|_| {
+                key_err(
+                    "filter.gate",
+                    format!(
+                        "{:?} is not a gate: expected one of {}",
+                        self.filter.gate,
+                        crate::nav::filter::model::GATE_CHOICES
+                    ),
+                )
+            })
     }
 
     /// The filter's noise model and the initial σ of its 12 sensor states, from the
