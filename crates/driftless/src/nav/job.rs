@@ -28,9 +28,9 @@ pub enum NavJobError {
     /// An input file or its timing.
     #[error(transparent)]
     Input(#[from] PipelineError),
-    /// Reading a log (the CSV path).
+    /// Reading a log (the CSV path). Boxed: [`crate::io::LogError`] is large.
     #[error(transparent)]
-    Read(#[from] crate::io::LogError),
+    Read(Box<crate::io::LogError>),
     /// The calibration model file.
     #[error(transparent)]
     Calibration(#[from] crate::calib::model_file::ModelFileError),
@@ -43,6 +43,12 @@ pub enum NavJobError {
     /// The filter or the session.
     #[error(transparent)]
     Nav(#[from] crate::nav::filter::NavError),
+}
+
+impl From<crate::io::LogError> for NavJobError {
+    fn from(e: crate::io::LogError) -> Self {
+        NavJobError::Read(Box::new(e))
+    }
 }
 
 /// The IMU reader a job uses.

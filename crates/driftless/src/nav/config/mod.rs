@@ -901,20 +901,16 @@ impl NavConfig {
     /// The innovation gate ([`Gate`]: `off`, `chi2:P`, `robust` or
     /// `robust:P_INFLATE:P_REJECT:MAX_SIGMA_SCALE`).
     pub fn gate(&self) -> Result<Gate, KeyError> {
-        self.filter
-            .gate
-            .trim()
-            .parse::<Gate>()
-            .map_err(|_| {
-                key_err(
-                    "filter.gate",
-                    format!(
-                        "{:?} is not a gate: expected one of {}",
-                        self.filter.gate,
-                        crate::nav::filter::model::GATE_CHOICES
-                    ),
-                )
-            })
+        self.filter.gate.trim().parse::<Gate>().map_err(|_| {
+            key_err(
+                "filter.gate",
+                format!(
+                    "{:?} is not a gate: expected one of {}",
+                    self.filter.gate,
+                    crate::nav::filter::model::GATE_CHOICES
+                ),
+            )
+        })
     }
 
     /// The filter's noise model and the initial σ of its 12 sensor states, from the
