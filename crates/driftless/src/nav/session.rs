@@ -499,16 +499,9 @@ pub fn initialise(
         let n = &fcfg.imu;
         // Primed from ≥ a few seconds of static data: the residual is the Earth rate plus
         // the short-term drift; keep the other sensor states at their initial σ.
-        let mut s = cfg.initial_sensor_sigma.unwrap_or_else(|| {
-            let mut s = [0.0; 12];
-            for k in 0..3 {
-                s[k] = n.gyro_bias.sigma;
-                s[3 + k] = n.accel_bias.sigma;
-                s[6 + k] = n.gyro_scale.sigma;
-                s[9 + k] = n.accel_scale.sigma;
-            }
-            s
-        });
+        let mut s = cfg
+            .initial_sensor_sigma
+            .unwrap_or_else(|| fcfg.stationary_sensor_sigma());
         for v in &mut s[..3] {
             *v = (0.05f64.to_radians()).min(n.gyro_bias.sigma);
         }

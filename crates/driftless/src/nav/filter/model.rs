@@ -503,6 +503,20 @@ impl FilterConfig {
         Ok(())
     }
 
+    /// The stationary Gauss–Markov σ of the 12 sensor states (b_g, b_a, s_g, s_a, three
+    /// each): the default initial uncertainty.
+    pub fn stationary_sensor_sigma(&self) -> [f64; 12] {
+        let n = &self.imu;
+        let mut s = [0.0; 12];
+        for k in 0..3 {
+            s[k] = n.gyro_bias.sigma;
+            s[3 + k] = n.accel_bias.sigma;
+            s[6 + k] = n.gyro_scale.sigma;
+            s[9 + k] = n.accel_scale.sigma;
+        }
+        s
+    }
+
     /// Diagonal of the continuous process-noise PSD G Q Gᵀ (module docs).
     pub fn q_c_diag(&self) -> [f64; N_STATES] {
         let n = &self.imu;

@@ -107,17 +107,9 @@ pub struct InitialState {
 impl InitialState {
     /// Diagonal initial covariance.
     pub fn covariance(&self, cfg: &FilterConfig) -> Cov {
-        let n = &cfg.imu;
-        let s = self.sigma_sensors.unwrap_or_else(|| {
-            let mut s = [0.0; 12];
-            for k in 0..3 {
-                s[k] = n.gyro_bias.sigma;
-                s[3 + k] = n.accel_bias.sigma;
-                s[6 + k] = n.gyro_scale.sigma;
-                s[9 + k] = n.accel_scale.sigma;
-            }
-            s
-        });
+        let s = self
+            .sigma_sensors
+            .unwrap_or_else(|| cfg.stationary_sensor_sigma());
         let mut p = [[0.0; N_STATES]; N_STATES];
         for k in 0..3 {
             p[k][k] = self.sigma_pos_ned_m[k].powi(2);
