@@ -12,14 +12,14 @@
 //! and, through an independent stream, the GNSS noise).
 //!
 //! **Filter.** `nav::session::run_session` with only the geometry given — lever arm
-//! (0, 0, −0.25) m, mounting identity — and the default filter ([`FilterConfig::new`]:
-//! χ² gate 21.1, gate recovery 3 s, no aids), IMU noise from the `consumer` preset's
-//! numbers ([`walk_noise`]); no per-seed tuning. One deviation from the session defaults:
-//! `min_speed_m_s = 0.8` (the default 3 m/s is never reached on foot; the heading is
-//! then taken from the central difference of the fixes around the first epoch above
-//! 0.8 m/s). Three filter variants are measured: **A** the default χ² gate, **B** the
-//! fixes' σ floored at 0.1 m / 0.2 m (`SessionConfig::sigma_floor_m`), **C** no gate
-//! (`FilterConfig::gate = Gate::Off`).
+//! (0, 0, −0.25) m, mounting identity — and the library's defaults
+//! ([`SessionConfig::new`] over [`FilterConfig::new`]: robust gate, gate recovery 3 s,
+//! alignment from 0.5 m/s, no aids), IMU noise from the `consumer` preset's numbers ([`walk_noise`]); no per-seed
+//! tuning. Variants: the same with the σ floor a moving antenna calls for (0.2 m, 0.4 m
+//! vertical); and, on the older settings (χ² gate 0.9999, heading from 0.8 m/s), **A** the
+//! χ² gate, **B** the fixes' σ floored at 0.1 m / 0.2 m
+//! (`SessionConfig::sigma_floor_m`), **C** no gate (`FilterConfig::gate = Gate::Off`),
+//! and diagnostics D–H.
 //!
 //! **Figures** (per variant, pooled over the 20 seeds):
 //! (a) share of GNSS fixes rejected by the gate in the full-GNSS run,
@@ -44,37 +44,37 @@
 //!     not bad luck. Bar: ≥ 90 % of windows for each length. Reported alongside:
 //!     mean e_h, mean bound, and the mean of e_h²/(σ_N² + σ_E²) (≈ 1 when consistent).
 //!
-//! **Measured with today's filter** (release, 2 cores: 1.3 s to simulate the 20 walks,
-//! 2–3 s per variant for 20 seeds × 3 runs; `cargo test --release -p driftless --test
-//! nav_walk measure_ -- --ignored --nocapture`, with `WALK_DIAGNOSTICS=1` for D–H):
+//! **Measured** (release, 2 cores; 1–3 s per variant for 20 seeds × 3 runs;
+//! `cargo test --release -p driftless --test nav_walk measure_ -- --ignored --nocapture`,
+//! with `WALK_DIAGNOSTICS=1` for D–H):
 //!
-//! | variant | (a) rejected | (b) one-step / fix RMS (worst seed) | (c) 15 s: covered, mean e_h, mean 3σ_h | (c) 30 s: covered, mean e_h, mean 3σ_h | initial heading error RMS |
-//! |---|---|---|---|---|---|
-//! | A default χ² gate | 81.5 % (696 forced) | 2.04 / 0.361 m = 5.67 (35.6) | 20.0 %, 52.6 m, 15.8 m | 25.0 %, 196 m, 58.4 m | 47.8° |
-//! | B σ floor 0.1 / 0.2 m | 12.2 % | 0.895 / 0.361 m = 2.48 (19.9) | 72.5 %, 25.3 m, 12.9 m | 70.0 %, 77.4 m, 43.3 m | 47.8° |
-//! | C no gate | 0 % | 0.876 / 0.361 m = 2.43 (8.8) | 11.2 %, 25.0 m, 5.9 m | 15.0 %, 81.8 m, 21.1 m | 47.8° |
-//! | D σ floor 0.3 / 0.3 m | 8.8 % | 1.114 / 0.361 m = 3.09 (19.2) | 82.5 %, 27.3 m, 20.4 m | 81.7 %, 80.5 m, 68.6 m | 47.8° |
-//! | E = A, antenna rigid on its lever arm | 4.7 % | 0.254 / 0.234 m = 1.09 (6.1) | 92.5 %, 3.7 m, 6.3 m | 91.7 %, 19.5 m, 21.8 m | 1.4° |
-//! | F = D, IMU noise terms only | 7.0 % | 1.232 / 0.361 m = 3.42 (19.3) | 90.0 %, 18.1 m, 19.8 m | 86.7 %, 55.9 m, 66.4 m | 47.8° |
-//! | G = D, true initial attitude and velocity | 2.3 % | 0.453 / 0.361 m = 1.26 (5.0) | 91.2 %, 15.7 m, 19.5 m | 91.7 %, 46.7 m, 66.0 m | 0 |
-//! | H = A, true initial attitude and velocity | 80.0 % | 0.950 / 0.361 m = 2.63 (8.4) | 28.7 %, 37.0 m, 16.1 m | 30.0 %, 140 m, 58.5 m | 0 |
+//! | variant | (a) rejected | (b) one-step / fix RMS (worst seed) | (c) 15 s: covered, mean e_h, mean 3σ_h, mean e²/σ² | (c) 30 s: covered, mean e_h, mean 3σ_h, mean e²/σ² |
+//! |---|---|---|---|---|
+//! | defaults | 0.00 % | 0.696 / 0.361 m = 1.93 (5.93) | 23.8 %, 21.2 m, 7.2 m, 122 | 18.3 %, 66.5 m, 23.8 m, 114 |
+//! | defaults + σ floor 0.2 / 0.4 m | 0.00 % | 0.677 / 0.362 m = 1.87 (7.31) | 88.8 %, 13.8 m, 17.0 m, 30.5 | 91.7 %, 43.0 m, 57.2 m, 35.3 |
+//! | A χ² gate | 79.2 % | 1.820 / 0.361 m = 5.04 (12.9) | 17.5 %, 152 m, 86.1 m, 81.3 | 33.3 %, 410 m, 338 m, 36.8 |
+//! | B σ floor 0.1 / 0.2 m | 5.12 % | 0.369 / 0.361 m = 1.02 (4.07) | 81.2 %, 20.1 m, 14.1 m, 20.9 | 83.3 %, 54.7 m, 52.7 m, 12.7 |
+//! | C no gate | 0 % | 0.472 / 0.361 m = 1.31 (2.06) | 6.2 %, 23.6 m, 5.5 m, 252 | 6.7 %, 82.4 m, 20.2 m, 219 |
+//! | D σ floor 0.3 / 0.3 m | 2.46 % | 0.490 / 0.364 m = 1.34 (5.77) | 92.5 %, 14.6 m, 21.0 m, 28.7 | 95.0 %, 36.6 m, 90.4 m, 10.5 |
+//! | E = A, antenna rigid on its lever arm | 3.59 % | 0.209 / 0.235 m = 0.89 (3.44) | 90.0 %, 7.0 m, 6.3 m, 24.6 | 91.7 %, 22.9 m, 24.2 m, 19.9 |
+//! | F = D, IMU noise terms only | 0.01 % | 0.276 / 0.364 m = 0.76 (0.98) | 100 %, 5.4 m, 20.6 m, 0.9 | 100 %, 17.9 m, 72.5 m, 0.8 |
+//! | G = D, true initial attitude and velocity | 2.25 % | 0.452 / 0.364 m = 1.24 (4.84) | 92.5 %, 13.4 m, 20.9 m, 27.1 | 95.0 %, 32.9 m, 88.7 m, 9.7 |
+//! | H = A, true initial attitude and velocity | 79.4 % | 1.981 / 0.361 m = 5.48 (16.8) | 18.8 %, 130 m, 83.3 m, 95.9 | 30.0 %, 470 m, 407 m, 35.1 |
 //!
-//! (The fix RMS of E is the float stretch's and the 5-mm white error: its antenna does
-//! not move.) Reading: no variant of today's filter meets all three bars. Two things
-//! break it, each visible on its own: (1) the initial heading — from the central
-//! difference of fixes whose antenna moves by decimetres, at 0.8 m/s, it is wrong by
-//! 48° RMS (1.4° with a rigid antenna): 3 of the 20 seeds start during the initial
-//! standstill, the antenna motion alone faking more than 0.8 m/s (heading errors 175°,
-//! 106°, 26°), the other 17 at a true 0.6–1.1 m/s with 14° RMS (worst 38.5°); every
-//! variant started there misses (c);
-//! (2) the 1-cm formal σ against 0.28-m antenna motion — the χ² gate then rejects 80 %
-//! of the fixes even from the true attitude (H), while a σ floor at the motion's σ with
-//! the true attitude (G) comes close to every bar (a 2.3 %, b 1.26×, c 91 / 92 %).
-//! Free-inertial drift of this consumer IMU without aids is tens of metres in 30 s
-//! (E: 19.5 m with a rigid antenna), so (c) is a consistency bar, not an accuracy one.
-//! Today's filter does not meet the bars, so the asserting test is ignored until the
-//! filter has σ inflation instead of rejection as its default gate and an alignment
-//! that works at walking speed.
+//! Reading: the defaults meet (a) only. Two things break them, each visible on its own:
+//! (1) the 1-cm formal σ against 0.28-m antenna motion: the filter believes every fix to
+//! a centimetre and is over-confident at every outage end (mean e²/σ² ≈ 120); a σ floor
+//! at the motion's size (the hand-held setting, row 2) brings (c) to 89 % / 92 %.
+//! (2) error terms the 21-state filter does not model — the consumer preset's cross-axis
+//! sensitivity, misalignment and g-sensitivity: with the IMU's noise terms only (F) every
+//! bar is met with margin (0.76×, 100 % / 100 %, e²/σ² ≈ 1), while with every term one
+//! or two seeds diverge (worst seed 5–6× the fixes' RMS), which keeps (b) above 1.2×.
+//! Estimating the fixes' σ from the innovations (an innovation-based adaptive R with a
+//! lag-one correlation allowance) was tried and made every figure worse: the innovations
+//! of a filter whose P is inconsistent carry the state's drift, the estimated R grows,
+//! the fixes lose weight and the drift grows further. So did a covariance reset after a
+//! run of inconsistent fixes (it fires every few seconds when R, not P, is too small).
+//! The asserting test below is therefore ignored until the defaults meet the bars.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -155,6 +155,9 @@ fn walk_noise() -> ImuNoise {
 enum Variant {
     /// The library's defaults: robust gate, alignment at walking speed.
     Default,
+    /// The defaults with the σ floor a moving antenna calls for
+    /// (`gnss.sigma_floor_m = 0.2`, vertical 0.4 m): the documented hand-held setting.
+    MovingAntennaFloor,
     Chi2Gate,
     SigmaFloor,
     NoGate,
@@ -173,8 +176,9 @@ enum Variant {
 }
 
 impl Variant {
-    const STUDY: [Variant; 4] = [
+    const STUDY: [Variant; 5] = [
         Variant::Default,
+        Variant::MovingAntennaFloor,
         Variant::Chi2Gate,
         Variant::SigmaFloor,
         Variant::NoGate,
@@ -190,6 +194,7 @@ impl Variant {
     fn label(self) -> &'static str {
         match self {
             Variant::Default => "defaults (robust gate)",
+            Variant::MovingAntennaFloor => "defaults + σ floor 0.2/0.4 m",
             Variant::Chi2Gate => "A χ² gate (chi2:0.9999)",
             Variant::SigmaFloor => "B σ floor 0.1/0.2 m",
             Variant::NoGate => "C no gate",
@@ -203,13 +208,19 @@ impl Variant {
 
     fn config(self, lever_b_m: [f64; 3]) -> SessionConfig {
         let mut c = SessionConfig::new(FilterConfig::new(walk_noise(), lever_b_m));
-        if self == Variant::Default {
-            return c;
+        match self {
+            Variant::Default => return c,
+            Variant::MovingAntennaFloor => {
+                c.sigma_floor_m = Some((0.2, 0.4));
+                return c;
+            }
+            _ => {}
         }
         c.min_speed_m_s = MIN_SPEED_M_S;
         c.filter.gate = Gate::Chi2 { p: 0.9999 };
         match self {
             Variant::Default
+            | Variant::MovingAntennaFloor
             | Variant::Chi2Gate
             | Variant::RigidAntenna
             | Variant::Chi2GateTrueHeading => {}
@@ -751,11 +762,11 @@ fn walk_simulation_matches_the_scenario_and_the_filter_runs() {
 
 /// The study's bars under the default filter (module documentation).
 #[test]
-#[ignore = "bar not met yet: the robust default gate rejects 0 % of the fixes (bar < 2 %), but \
-            with a 1-cm formal σ against 0.28-m correlated antenna motion the filter is \
-            over-confident: one-step RMS 1.93× the fixes' error (bar 1.2×), outage ends inside \
-            3σ in 24 % (15 s) and 18 % (30 s) of windows (bar 90 %); needs measurement noise \
-            estimated from the innovations"]
+#[ignore = "bar not met yet: the defaults reject 0 % of the fixes (bar < 2 %), but with a \
+            1-cm formal σ against 0.28-m correlated antenna motion the filter is over-confident: \
+            one-step RMS 1.93× the fixes' error (bar 1.2×), outage ends inside 3σ in 24 % (15 s) \
+            and 18 % (30 s) of windows (bar 90 %); with a 0.2-m σ floor 1.87×, 89 % and 92 %; \
+            with the IMU's noise terms only every bar is met"]
 fn measure_walk_study_against_the_bars() {
     let p = study(&[Variant::Default])[0];
     assert!(
@@ -786,7 +797,7 @@ fn measure_walk_study_against_the_bars() {
 fn measure_walk_filter_variants() {
     let clock = Instant::now();
     let rows = study(&Variant::STUDY);
-    assert_eq!(rows.len(), 4);
+    assert_eq!(rows.len(), 5);
     if std::env::var_os("WALK_DIAGNOSTICS").is_some() {
         study(&Variant::DIAGNOSTICS);
     }
