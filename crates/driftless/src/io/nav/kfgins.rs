@@ -631,12 +631,15 @@ fn put_value(out: &mut [u8], v: f64) -> Option<usize> {
         out[n] = b'0' + int as u8;
         n += 1;
     } else {
-        let int_digits = int.ilog10() as usize + 1;
-        // The integer's digits are the last `int_digits` of its eight; the zero bytes
+        // The digit values (not yet ASCII), most significant first: the leading zero
+        // digits are the low-order zero bytes (int ≥ 10, so at most six of them). The
+        // integer's digits are the last `int_digits` of its eight; the zero bytes
         // shifted in behind them are overwritten by the point and the fraction.
-        let int_ascii = eight_digits(int as u32) >> (8 * (8 - int_digits));
+        let digits = eight_digit_values(int as u32);
+        let lead = (digits.trailing_zeros() / 8) as usize;
+        let int_ascii = (digits + ASCII_ZEROS) >> (8 * lead);
         out[n..n + 8].copy_from_slice(&int_ascii.to_le_bytes());
-        n += int_digits;
+        n += 8 - lead;
     }
     out[n] = b'.';
     out[n + 1] = b'0' + (frac / 100_000_000) as u8;
@@ -645,20 +648,28 @@ fn put_value(out: &mut [u8], v: f64) -> Option<usize> {
     Some(n.max(15) + 1)
 }
 
+/// Eight ASCII `'0'` bytes.
+const ASCII_ZEROS: u64 = 0x3030_3030_3030_3030;
+
 /// The eight decimal digits of `x` < 10⁸ (zero-padded) as ASCII bytes of a little-endian
-/// u64, the most significant digit first: x splits into two 4-digit halves in 32-bit
-/// lanes, each into two 2-digit quarters in 16-bit lanes, each into two digits in bytes,
-/// by multiply-shift division (x/100 = ⌊10486x / 2²⁰⌋ for x < 10⁴, x/10 = ⌊103x / 2¹⁰⌋
-/// for x < 100; no carry crosses a lane).
+/// u64, the most significant digit first ([`eight_digit_values`] plus `'0'`).
 fn eight_digits(x: u32) -> u64 {
+    eight_digit_values(x) + ASCII_ZEROS
+}
+
+/// The eight decimal digits of `x` < 10⁸ (zero-padded) as byte values 0–9 of a
+/// little-endian u64, the most significant digit first: x splits into two 4-digit halves
+/// in 32-bit lanes, each into two 2-digit quarters in 16-bit lanes, each into two digits
+/// in bytes, by multiply-shift division (x/100 = ⌊10486x / 2²⁰⌋ for x < 10⁴,
+/// x/10 = ⌊103x / 2¹⁰⌋ for x < 100; no carry crosses a lane).
+fn eight_digit_values(x: u32) -> u64 {
     let hi = u64::from(x / 10_000);
     let lo = u64::from(x % 10_000);
     let v = hi | (lo << 32);
     let q = ((v * 10_486) >> 20) & 0x0000_007F_0000_007F;
     let v = q | ((v - q * 100) << 16);
     let q = ((v * 103) >> 10) & 0x000F_000F_000F_000F;
-    let v = q | ((v - q * 10) << 8);
-    v + 0x3030_3030_3030_3030
+    q | ((v - q * 10) << 8)
 }
 
 #[cfg(test)]

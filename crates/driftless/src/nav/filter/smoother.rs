@@ -91,7 +91,7 @@
 //! cache), so the smoother runs on one thread.
 
 use super::NavError;
-use super::model::{FilterConfig, Transition};
+use super::model::{FilterConfig, NAV_ROW_COLS, Transition};
 use super::run::{ForwardRun, InitialState};
 use super::state::{ATT, BA, BG, Cov, N_STATES, POS, SA, SG, SensorErrors, VEL, unpack};
 use crate::nav::earth;
@@ -373,8 +373,35 @@ fn nav_rows(t: &Transition) -> ([[f64; N_STATES]; 9], [f64; N_STATES]) {
     (t.nav_rows(), e)
 }
 
-/// λ ← Φᵀ λ, Λ ← Φᵀ Λ Φ.
+/// λ ← Φᵀ λ, Λ ← Φᵀ Λ Φ. On x86-64 CPUs with AVX2 a copy compiled for AVX2 runs; it
+/// performs the same operations in the same order (bit-identical results).
+#[inline]
+#[allow(unsafe_code)]
 fn adjoint_step(t: &Transition, adj: &mut Adjoint) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: `adjoint_step_avx2` differs from the portable kernel only in being
+            // compiled with the `avx2` target feature; the CPU supports AVX2 (checked just
+            // above), which is the sole requirement for calling it.
+            return unsafe { adjoint_step_avx2(t, adj) };
+        }
+    }
+    adjoint_step_portable(t, adj)
+}
+
+/// [`adjoint_step`] compiled with AVX2 enabled.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn adjoint_step_avx2(t: &Transition, adj: &mut Adjoint) {
+    adjoint_step_portable(t, adj)
+}
+
+/// The portable kernel of [`adjoint_step`]. The sparse row combinations run over the
+/// structurally non-zero columns of each navigation row of A ([`NAV_ROW_COLS`]), so no
+/// branch per coefficient (a coefficient that happens to be zero adds an exact zero).
+#[inline(always)]
+fn adjoint_step_portable(t: &Transition, adj: &mut Adjoint) {
     let (a, e) = nav_rows(t);
     let lam = &adj.lam;
     let mut l2: [f64; N_STATES] = std::array::from_fn(|i| e[i] * lam[i]);
@@ -397,13 +424,11 @@ fn adjoint_step(t: &Transition, adj: &mut Adjoint) {
     }
     for m in 0..9 {
         let src = &big[m];
-        for i in 0..N_STATES {
+        for &i in NAV_ROW_COLS[m] {
             let coef = a[m][i];
-            if coef != 0.0 {
-                let dst = &mut v[i];
-                for c in 0..N_STATES {
-                    dst[c] += coef * src[c];
-                }
+            let dst = &mut v[i];
+            for c in 0..N_STATES {
+                dst[c] += coef * src[c];
             }
         }
     }
@@ -426,18 +451,57 @@ fn adjoint_step(t: &Transition, adj: &mut Adjoint) {
     }
     for m in 0..9 {
         let src = &w[m];
-        for i in 0..N_STATES {
+        for &i in NAV_ROW_COLS[m] {
             let coef = a[m][i];
-            if coef != 0.0 {
-                let dst = &mut r[i];
-                for c in 0..N_STATES {
-                    dst[c] += coef * src[c];
-                }
+            let dst = &mut r[i];
+            for c in 0..N_STATES {
+                dst[c] += coef * src[c];
             }
         }
     }
     symmetrize(&mut r);
     adj.big = r;
+}
+
+/// M = Λ P (dense rows), dispatched like [`adjoint_step`] (bit-identical copies).
+#[inline]
+#[allow(unsafe_code)]
+fn lambda_times_p(big: &Cov, p: &Cov) -> Cov {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: as in `adjoint_step`: only the target feature differs, and the CPU
+            // has AVX2.
+            return unsafe { lambda_times_p_avx2(big, p) };
+        }
+    }
+    lambda_times_p_portable(big, p)
+}
+
+/// [`lambda_times_p`] compiled with AVX2 enabled.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn lambda_times_p_avx2(big: &Cov, p: &Cov) -> Cov {
+    lambda_times_p_portable(big, p)
+}
+
+/// The portable kernel of [`lambda_times_p`]: row i of M = Σ_j Λ_ij P_j, j ascending.
+#[inline(always)]
+fn lambda_times_p_portable(big: &Cov, p: &Cov) -> Cov {
+    let mut m = [[0.0; N_STATES]; N_STATES];
+    for i in 0..N_STATES {
+        let li = &big[i];
+        let mut acc = [0.0; N_STATES];
+        for j in 0..N_STATES {
+            let coef = li[j];
+            let pj = &p[j];
+            for c in 0..N_STATES {
+                acc[c] += coef * pj[c];
+            }
+        }
+        m[i] = acc;
+    }
+    m
 }
 
 /// Smoothed epoch k from the stored record, P⁺_k and λ⁺, Λ⁺; also e_s and (if
@@ -460,19 +524,7 @@ fn output(
         s
     });
     // M = Λ P (rows), diag(P M).
-    let mut m = [[0.0; N_STATES]; N_STATES];
-    for i in 0..N_STATES {
-        let li = &adj.big[i];
-        let mut acc = [0.0; N_STATES];
-        for j in 0..N_STATES {
-            let coef = li[j];
-            let pj = &p[j];
-            for c in 0..N_STATES {
-                acc[c] += coef * pj[c];
-            }
-        }
-        m[i] = acc;
-    }
+    let m = lambda_times_p(&adj.big, p);
     let mut std = [0.0; N_STATES];
     for i in 0..N_STATES {
         let mut s = 0.0;
