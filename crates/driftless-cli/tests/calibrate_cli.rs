@@ -215,7 +215,13 @@ fn multi_position_without_a_guess_and_a_poor_fit() {
     assert!(!dir.join("cal.toml").exists());
     // Accepted: exit 0, the verdict in the JSON and on stderr.
     let out = bin()
-        .args(["calibrate", "multi-position", "--json", "--gravity", "9.81744"])
+        .args([
+            "calibrate",
+            "multi-position",
+            "--json",
+            "--gravity",
+            "9.81744",
+        ])
         .args(["--gyro-scale-guess", "1", "--accept-poor-fit"])
         .arg(d.join("xsens_acc.txt"))
         .arg(d.join("xsens_gyro.txt"))
@@ -225,7 +231,10 @@ fn multi_position_without_a_guess_and_a_poor_fit() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["accepted_poor_fit"], true);
     assert_eq!(
-        v["quality"]["gyro"]["implausible"].as_array().unwrap().len(),
+        v["quality"]["gyro"]["implausible"]
+            .as_array()
+            .unwrap()
+            .len(),
         1
     );
     assert!(String::from_utf8_lossy(&out.stderr).contains("warning: gyro fit"));

@@ -374,7 +374,9 @@ fn simulated_poses_coverage() {
         adis.iter().map(|c| c.1).sum::<f64>() / nc,
         adis.iter().map(|c| c.2).sum::<f64>() / nc,
     );
-    let worst = chi2.iter().fold((0.0f64, 0.0f64), |m, c| (m.0.max(c.1), m.1.max(c.2)));
+    let worst = chi2
+        .iter()
+        .fold((0.0f64, 0.0f64), |m, c| (m.0.max(c.1), m.1.max(c.2)));
     println!(
         "ADIS16465-like mean χ²/dof accel {ca:.3}, gyro {cg:.3} over {nc} runs; largest over both presets {worst:.2?}"
     );
@@ -635,7 +637,11 @@ fn turns_about_the_vertical_cannot_give_the_gyro_scale() {
     let moves: Vec<Vec3> = (0..12)
         .map(|i| {
             let tilt = if i % 2 == 0 { 2f64 } else { -2.0 };
-            [tilt.to_radians(), 0.0, (60.0 + 120.0 * rng.next()).to_radians()]
+            [
+                tilt.to_radians(),
+                0.0,
+                (60.0 + 120.0 * rng.next()).to_radians(),
+            ]
         })
         .collect();
     let (t, w, iv) = sim_intervals(&moves, rot([std::f64::consts::PI, 0.0, 0.0]));

@@ -604,7 +604,10 @@ fn chi2_warnings_name_their_likely_causes() {
         "white noise: χ²/dof accel {:.2}, gyro {:.2}",
         a.chi2_per_dof, g.chi2_per_dof
     );
-    assert!(a.warnings.is_empty() && g.warnings.is_empty(), "{a:?} {g:?}");
+    assert!(
+        a.warnings.is_empty() && g.warnings.is_empty(),
+        "{a:?} {g:?}"
+    );
     assert!(a.chi2_per_dof < DEFAULT_WARN_CHI2_PER_DOF && g.chi2_per_dof.is_finite());
     // 0.1 °/s per g on every axis pair: 1.8e-4 rad/s per m/s².
     cfg.gyro.g_sensitivity_rad_s_per_m_s2 = [[1.8e-4; 3]; 3];

@@ -831,7 +831,9 @@ fn search_scale(
     let n = ((hi - lo) / step).ceil() as usize + 1;
     let grid: Vec<f64> = (0..n).map(|i| lo + step * i as f64).collect();
     let cost: Vec<f64> = grid.iter().map(|&l| scale_cost(moves, l.exp())).collect();
-    let ibest = (0..n).min_by(|&a, &b| cost[a].total_cmp(&cost[b])).unwrap_or(0);
+    let ibest = (0..n)
+        .min_by(|&a, &b| cost[a].total_cmp(&cost[b]))
+        .unwrap_or(0);
     // Golden section on ln s around the grid minimum.
     let (mut a, mut b) = (grid[ibest] - step, grid[ibest] + step);
     let phi = 0.5 * (5f64.sqrt() - 1.0);
@@ -1187,7 +1189,8 @@ pub fn multi_position_quality(
         let proj = |e: Vec3| -> Vec<f64> { cal_k.iter().map(|a| dot(e, *a)).collect() };
         let var_u = mean_variance(&proj(u)).max(floor(u));
         perp_var.push(
-            0.5 * (mean_variance(&proj(e1)).max(floor(e1)) + mean_variance(&proj(e2)).max(floor(e2))),
+            0.5 * (mean_variance(&proj(e1)).max(floor(e1))
+                + mean_variance(&proj(e2)).max(floor(e2))),
         );
         chi2_a += (n - g).powi(2) / var_u.max(1e-300);
     }

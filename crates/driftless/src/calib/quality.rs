@@ -27,11 +27,7 @@ impl FitQuality {
     /// The figures, with a warning when χ²/ν exceeds `warn_chi2_per_dof`; `causes` lists
     /// the likely causes for this fit.
     pub fn from_chi2(chi2: f64, dof: usize, warn_chi2_per_dof: f64, causes: &str) -> FitQuality {
-        let chi2_per_dof = if dof > 0 {
-            chi2 / dof as f64
-        } else {
-            f64::NAN
-        };
+        let chi2_per_dof = if dof > 0 { chi2 / dof as f64 } else { f64::NAN };
         let mut warnings = Vec::new();
         if chi2_per_dof > warn_chi2_per_dof {
             warnings.push(format!(
@@ -73,7 +69,15 @@ mod tests {
         assert!(ok.warnings.is_empty() && ok.is_plausible());
         let bad = FitQuality::from_chi2(400.0, 10, 3.0, "unmodelled drift");
         assert_eq!(bad.warnings.len(), 1);
-        assert!(bad.warnings[0].contains("unmodelled drift"), "{:?}", bad.warnings);
-        assert!(FitQuality::from_chi2(1.0, 0, 3.0, "x").chi2_per_dof.is_nan());
+        assert!(
+            bad.warnings[0].contains("unmodelled drift"),
+            "{:?}",
+            bad.warnings
+        );
+        assert!(
+            FitQuality::from_chi2(1.0, 0, 3.0, "x")
+                .chi2_per_dof
+                .is_nan()
+        );
     }
 }

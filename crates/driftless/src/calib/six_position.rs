@@ -425,7 +425,9 @@ impl SixPositionCalibration {
             self.gyro.chi2,
             self.gyro.dof,
             warn_chi2_per_dof,
-            &format!("{common}, rate-table rates or site latitude (Earth rate) other than given{g_sens}"),
+            &format!(
+                "{common}, rate-table rates or site latitude (Earth rate) other than given{g_sens}"
+            ),
         );
         (accel, gyro)
     }
