@@ -45,7 +45,7 @@ pub struct Stationarity {
 impl Stationarity {
     /// True when the ratio exceeds [`NON_STATIONARY_FACTOR`] × the expected one.
     pub fn is_static(&self) -> bool {
-        !(self.ratio > NON_STATIONARY_FACTOR * self.expected_ratio)
+        self.ratio <= NON_STATIONARY_FACTOR * self.expected_ratio || self.ratio.is_nan()
     }
 }
 

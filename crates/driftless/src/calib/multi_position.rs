@@ -981,8 +981,8 @@ fn gyro_fit(
         for w in &mut mv.w {
             *w = w.map(|v| v * s0);
         }
-        for j in 0..3 {
-            net[j] += mv.net_raw_s[j] * s0;
+        for (n, r) in net.iter_mut().zip(mv.net_raw_s) {
+            *n += r * s0;
         }
     }
     for j in 0..3 {
