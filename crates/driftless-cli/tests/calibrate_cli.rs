@@ -93,6 +93,29 @@ fn data_dir() -> PathBuf {
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"))
 }
 
+/// `driftless calibrate multi-position --json` with the imu_tk authors' gravity.
+fn xsens_multi() -> std::process::Command {
+    let mut c = bin();
+    c.args([
+        "calibrate",
+        "multi-position",
+        "--json",
+        "--gravity",
+        "9.81744",
+    ]);
+    c
+}
+
+/// Static intervals, RMS |a| − g (m/s²) and gravity-direction angle RMS (°) of a
+/// multi-position `--json` document.
+fn figures(v: &serde_json::Value) -> (usize, f64, f64) {
+    (
+        v["static_intervals"].as_array().unwrap().len(),
+        v["accel"]["residual_rms"].as_f64().unwrap(),
+        v["gyro"]["residual_rms"].as_f64().unwrap().to_degrees(),
+    )
+}
+
 /// imu_tk's recording: 38 intervals, RMS(|a| − g) 0.00112 m/s², 0.52° gravity-direction
 /// RMS after integrating the calibrated gyro (imu_tk, C++/Ceres, ~0.7 s): match or beat.
 #[test]
@@ -100,21 +123,12 @@ fn data_dir() -> PathBuf {
 fn multi_position_on_the_imu_tk_recording() {
     let d = data_dir().join("calib/imu_tk_xsens");
     let v = run_json(
-        bin()
-            .args([
-                "calibrate",
-                "multi-position",
-                "--json",
-                "--gravity",
-                "9.81744",
-            ])
+        xsens_multi()
             .args(["--gyro-scale-guess", "1.598e-4"])
             .arg(d.join("xsens_acc.txt"))
             .arg(d.join("xsens_gyro.txt")),
     );
-    let n = v["static_intervals"].as_array().unwrap().len();
-    let rms = v["accel"]["residual_rms"].as_f64().unwrap();
-    let ang = v["gyro"]["residual_rms"].as_f64().unwrap().to_degrees();
+    let (n, rms, ang) = figures(&v);
     let secs = v["seconds"].as_f64().unwrap();
     eprintln!(
         "imu_tk Xsens via the CLI: {n} intervals, RMS |a| − g {rms:.5} m/s², gravity angle \
@@ -137,14 +151,7 @@ fn multi_position_on_the_imu_tk_recording() {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("both.txt"), both).unwrap();
     let one = run_json(
-        bin()
-            .args([
-                "calibrate",
-                "multi-position",
-                "--json",
-                "--gravity",
-                "9.81744",
-            ])
+        xsens_multi()
             .args(["--gyro-scale-guess", "1.598e-4"])
             .arg(dir.join("both.txt")),
     );
@@ -161,20 +168,11 @@ fn multi_position_on_the_imu_tk_recording() {
 fn multi_position_without_a_guess_and_a_poor_fit() {
     let d = data_dir().join("calib/imu_tk_xsens");
     let v = run_json(
-        bin()
-            .args([
-                "calibrate",
-                "multi-position",
-                "--json",
-                "--gravity",
-                "9.81744",
-            ])
+        xsens_multi()
             .arg(d.join("xsens_acc.txt"))
             .arg(d.join("xsens_gyro.txt")),
     );
-    let n = v["static_intervals"].as_array().unwrap().len();
-    let rms = v["accel"]["residual_rms"].as_f64().unwrap();
-    let ang = v["gyro"]["residual_rms"].as_f64().unwrap().to_degrees();
+    let (n, rms, ang) = figures(&v);
     let s = v["gyro_scale_estimate"]["scale_rad_s_per_raw"]
         .as_f64()
         .unwrap();

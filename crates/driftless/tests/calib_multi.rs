@@ -394,6 +394,23 @@ fn sim_log(moves: &[Vec3], c0: Mat3) -> (Vec<f64>, Vec<Vec3>, Vec<Vec3>) {
     columns(&out)
 }
 
+/// Asserts that `e` says `parameter` of `sensor` is not observable, prints it, returns
+/// the reason.
+fn expect_unobservable(e: &CalibError, sensor: &str, parameter: &str) -> String {
+    println!("{e}");
+    match e {
+        CalibError::Unobservable {
+            sensor: s,
+            parameter: p,
+            reason,
+        } => {
+            assert_eq!((*s, p.as_str()), (sensor, parameter), "{e}");
+            reason.clone()
+        }
+        other => panic!("{other}"),
+    }
+}
+
 #[test]
 fn too_few_intervals() {
     let mut rng = Gen(7);
@@ -425,15 +442,7 @@ fn all_poses_z_up_leave_x_scale_unobservable() {
     let c0 = rot([std::f64::consts::PI, 0.0, 0.0]);
     let (t, a, w) = sim_log(&moves, c0);
     let e = calibrate_multi_position(&t, &a, &w, &sim_options()).unwrap_err();
-    match &e {
-        CalibError::Unobservable {
-            sensor, parameter, ..
-        } => {
-            assert_eq!((*sensor, parameter.as_str()), ("accelerometer", "x scale"));
-        }
-        other => panic!("{other}"),
-    }
-    println!("{e}");
+    expect_unobservable(&e, "accelerometer", "x scale");
 }
 
 #[test]
@@ -483,15 +492,7 @@ fn all_static_log_leaves_gyro_scale_unobservable() {
     let still: Vec<Vec3> = (0..t.len()).map(|k| w[k % w.len()]).collect();
     // without a scale guess the scale search finds no scale that carries gravity
     let e = calibrate_gyro(&t, &still, &cal.intervals, &cal.accel.calibration, &opts).unwrap_err();
-    match &e {
-        CalibError::Unobservable {
-            sensor, parameter, ..
-        } => {
-            assert_eq!((*sensor, parameter.as_str()), ("gyro", "scale"));
-        }
-        other => panic!("{other}"),
-    }
-    println!("{e}");
+    expect_unobservable(&e, "gyro", "scale");
     // with a guess the per-axis rotation check names the axis
     let guessed = MultiPositionOptions {
         gyro_scale_guess_rad_s_per_raw: Some(1.0),
@@ -499,15 +500,7 @@ fn all_static_log_leaves_gyro_scale_unobservable() {
     };
     let e =
         calibrate_gyro(&t, &still, &cal.intervals, &cal.accel.calibration, &guessed).unwrap_err();
-    match &e {
-        CalibError::Unobservable {
-            sensor, parameter, ..
-        } => {
-            assert_eq!((*sensor, parameter.as_str()), ("gyro", "x scale"));
-        }
-        other => panic!("{other}"),
-    }
-    println!("{e}");
+    expect_unobservable(&e, "gyro", "x scale");
     // the detector alone on the good log
     let iv = detect_static(&t, &a, &w_moving, &StaticDetectOptions::default()).expect("detect");
     assert_eq!(iv.len(), 31);
@@ -653,18 +646,8 @@ fn turns_about_the_vertical_cannot_give_the_gyro_scale() {
         &sim_options(),
     )
     .unwrap_err();
-    match &e {
-        CalibError::Unobservable {
-            sensor,
-            parameter,
-            reason,
-        } => {
-            assert_eq!((*sensor, parameter.as_str()), ("gyro", "scale"));
-            assert!(reason.contains("turns by only"), "{reason}");
-        }
-        other => panic!("{other}"),
-    }
-    println!("{e}");
+    let reason = expect_unobservable(&e, "gyro", "scale");
+    assert!(reason.contains("turns by only"), "{reason}");
 }
 
 #[test]
@@ -695,13 +678,5 @@ fn turns_about_one_axis_give_the_scale_but_not_the_other_axes() {
         est.scale_rad_s_per_raw
     );
     let e = calibrate_gyro(&t, &w, &iv, &identity_accel(), &opts).unwrap_err();
-    match &e {
-        CalibError::Unobservable {
-            sensor, parameter, ..
-        } => {
-            assert_eq!((*sensor, parameter.as_str()), ("gyro", "y scale"));
-        }
-        other => panic!("{other}"),
-    }
-    println!("{e}");
+    expect_unobservable(&e, "gyro", "y scale");
 }
