@@ -5,6 +5,7 @@ use crate::output::{Table, sci};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use driftless::allan::analysis::{AnalysisConfig, ChannelResult, analyse_channels};
+use driftless::allan::checks;
 use driftless::allan::fit::FitConfig;
 use driftless::allan::noise_model::NoiseModel;
 use driftless::allan::taus::TauSpec;
@@ -75,6 +76,9 @@ pub struct AllanOutput {
     pub quantities: Vec<Quantity>,
     pub units: Vec<String>,
     pub noise: Option<NoiseModel>,
+    /// Whether the record suits the analysis: not static, too short for a fitted term
+    /// (see `driftless::allan::checks`).
+    pub warnings: Vec<String>,
 }
 
 /// The analysis settings from the flags.
@@ -187,11 +191,38 @@ pub fn analyse_log(
             )?)
         }
     };
+    let mut warnings = Vec::new();
+    for (&i, d) in keep.iter().zip(&data) {
+        let name = &log.channels[i].name;
+        let rates: Vec<f64>;
+        let y: &[f64] = match cfg.data_type {
+            DataType::Frequency => d,
+            DataType::Phase => {
+                rates = d.windows(2).map(|w| (w[1] - w[0]) / log.tau0_s).collect();
+                &rates
+            }
+        };
+        warnings.extend(checks::stationarity_warning(name, y, log.tau0_s));
+    }
+    if let Some(model) = &noise {
+        let record_s = log.len() as f64 * log.tau0_s;
+        for (c, r) in model.channels.iter().zip(&results) {
+            let taus: Vec<f64> = r.points.iter().map(|p| p.tau).collect();
+            warnings.extend(checks::record_length_warnings(
+                &c.name, &c.fit, &taus, record_s,
+            ));
+        }
+    }
+    let warnings = warnings
+        .into_iter()
+        .map(|w| format!("{}: {w}", log.source))
+        .collect();
     Ok(AllanOutput {
         results,
         quantities,
         units,
         noise,
+        warnings,
     })
 }
 
@@ -228,6 +259,9 @@ pub fn run(a: AllanArgs) -> Result<()> {
     );
     let out = analyse_log(&log, &cfg, fit.as_ref(), a.scale)?;
     spinner.finish_and_clear();
+    for w in &out.warnings {
+        eprintln!("warning: {w}");
+    }
 
     if let Some(p) = &a.save_model {
         let model = out
@@ -294,7 +328,7 @@ pub fn json_output(out: &AllanOutput) -> serde_json::Value {
         Some(m) => serde_json::to_value(m).unwrap_or(serde_json::Value::Null),
         None => serde_json::Value::Null,
     };
-    serde_json::json!({ "channels": channels, "noise": noise })
+    serde_json::json!({ "channels": channels, "noise": noise, "warnings": out.warnings })
 }
 
 fn human_output(out: &AllanOutput, log: &ImuLog, file: &Path) -> String {

@@ -1,13 +1,17 @@
 //! `driftless calibrate six-position|multi-position`: room-temperature calibration
 //! calibrated = M·(raw − b) of both triads, with σ, written as a calibration model file
 //! (`--out`), printed as tables or as `--json`:
-//! `{"accel":{"bias":[3],"matrix":[[3],[3],[3]],…},"gyro":{…},"static_intervals":[[t0,t1],…]}`
-//! (SI: m/s², rad/s; raw in the input's units).
+//! `{"accel":{"bias":[3],"matrix":[[3],[3],[3]],…},"gyro":{…},"static_intervals":[[t0,t1],…],
+//! "quality":{"accel":{"chi2_per_dof","dof","warnings":[…],"implausible":[…]},"gyro":{…}}}`
+//! (SI: m/s², rad/s; raw in the input's units). Multi-position adds
+//! `"gyro_scale_estimate"` (null when `--gyro-scale-guess` was given) and
+//! `"accepted_poor_fit"`; an implausible result fails unless `--accept-poor-fit`.
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use driftless::calib::model_file::{CalibrationFile, FORMAT_VERSION, TriadEntry};
 use driftless::calib::multi_position::{MultiPositionOptions, calibrate_multi_position};
+use driftless::calib::quality::FitQuality;
 use driftless::calib::six_position::{SixPositionInput, SixPositionOptions, calibrate};
 use driftless::io::{ImuLog, Quantity};
 use driftless::sim::chamber_manifest::ChamberManifest;
@@ -65,10 +69,16 @@ pub struct MultiArgs {
     pub accel: PathBuf,
     /// Gyro log (time + x, y, z), sampled with the accelerometer.
     pub gyro: Option<PathBuf>,
-    /// Gyro raw scale guess, rad/s per raw unit (1 when the log is in rad/s or in units
-    /// the reader converts; e.g. 1.6e-4 for 16-bit counts at ±300 deg/s). Within ±20 %.
-    #[arg(long, default_value_t = 1.0)]
-    pub gyro_scale_guess: f64,
+    /// Gyro raw scale guess, rad/s per raw unit, within ±20 % (e.g. 1.6e-4 for 16-bit
+    /// counts at ±300 deg/s; 1 for a log in rad/s). Default: found from the data (the
+    /// tilts between poses against the integrated raw gyro).
+    #[arg(long, value_name = "RAD_S_PER_RAW")]
+    pub gyro_scale_guess: Option<f64>,
+    /// Keep a result whose own quality figures are implausible (gravity direction after
+    /// integrating the gyro beyond 3° RMS, or |a| − g far above its noise) instead of
+    /// failing.
+    #[arg(long)]
+    pub accept_poor_fit: bool,
     /// Accelerometer zero offset, raw units (e.g. 32768 for offset-binary counts; the
     /// starting bias and the origin for classifying poses). Default: per axis, the
     /// middle of the 1st and 99th percentiles of the log.
@@ -220,10 +230,35 @@ fn multi(m: MultiArgs) -> Result<()> {
         ..MultiPositionOptions::default()
     };
     opts.detect.accel_offset_raw = offset;
+    let sources = match &m.gyro {
+        Some(p) => format!("{} + {}", m.accel.display(), p.display()),
+        None => m.accel.display().to_string(),
+    };
+    let span = match (time.first(), time.last()) {
+        (Some(a), Some(b)) => format!("{a:.2}–{b:.2} s"),
+        _ => "empty".into(),
+    };
     let t = Instant::now();
     let res = calibrate_multi_position(&time, &accel, &gyro, &opts)
-        .with_context(|| format!("calibrating {}", m.accel.display()))?;
+        .with_context(|| format!("calibrating {sources} ({span})"))?;
     let secs = t.elapsed().as_secs_f64();
+    let implausible: Vec<&String> = res
+        .accel_quality
+        .implausible
+        .iter()
+        .chain(&res.gyro_quality.implausible)
+        .collect();
+    if !implausible.is_empty() && !m.accept_poor_fit {
+        let list: Vec<String> = implausible.iter().map(|r| format!("  - {r}")).collect();
+        bail!(
+            "{sources} ({span}): the multi-position calibration is implausible, so it was not written:\n{}\n(pass --accept-poor-fit to keep it anyway)",
+            list.join("\n")
+        );
+    }
+    let quality = [
+        ("accelerometer", &res.accel_quality),
+        ("gyro", &res.gyro_quality),
+    ];
     let intervals: Vec<[f64; 2]> = res
         .intervals
         .iter()
@@ -232,10 +267,7 @@ fn multi(m: MultiArgs) -> Result<()> {
     let file = CalibrationFile {
         format_version: FORMAT_VERSION,
         method: "multi-position".into(),
-        source: match &m.gyro {
-            Some(p) => format!("{} + {}", m.accel.display(), p.display()),
-            None => m.accel.display().to_string(),
-        },
+        source: sources.clone(),
         gravity_m_s2: g,
         accel: entry(
             &res.accel.calibration,
@@ -318,14 +350,45 @@ fn multi(m: MultiArgs) -> Result<()> {
             "gravity direction after integrating the gyro, RMS",
             format!("{:.3}°", res.gravity_angle_rms_rad.to_degrees()),
         ),
+        (
+            "gyro scale",
+            match &res.gyro_scale {
+                Some(e) => format!(
+                    "{} rad/s per raw unit, found from the data (RMS gravity angle {:.2}° at M = s·I)",
+                    crate::output::sci(e.scale_rad_s_per_raw),
+                    e.gravity_angle_rms_rad.to_degrees()
+                ),
+                None => format!(
+                    "{} rad/s per raw unit, given (--gyro-scale-guess)",
+                    crate::output::sci(m.gyro_scale_guess.unwrap_or(f64::NAN))
+                ),
+            },
+        ),
+        (
+            "χ²/dof accel, gyro",
+            format!(
+                "{:.2}, {:.2}",
+                res.accel_quality.chi2_per_dof, res.gyro_quality.chi2_per_dof
+            ),
+        ),
         ("time", format!("{:.3} s", secs)),
     ];
+    let scale_json = res.gyro_scale.as_ref().map(|e| {
+        serde_json::json!({
+            "scale_rad_s_per_raw": e.scale_rad_s_per_raw,
+            "gravity_angle_rms_rad": e.gravity_angle_rms_rad,
+            "tilting_moves": e.tilting_moves,
+            "runner_up": e.runner_up.map(|(s, a)| serde_json::json!({"scale_rad_s_per_raw": s, "gravity_angle_rms_rad": a})),
+        })
+    });
     output(
         &m.common,
         &file,
         &summary,
         secs,
         (["#", "interval [s]", "pose", "|a| − g [m/s²]"], residuals),
+        &quality,
+        serde_json::json!({ "gyro_scale_estimate": scale_json, "accepted_poor_fit": !implausible.is_empty() }),
     )
 }
 
@@ -371,6 +434,8 @@ fn six(s: SixArgs) -> Result<()> {
     let t = Instant::now();
     let res = calibrate(&input, &opts)?;
     let secs = t.elapsed().as_secs_f64();
+    let (accel_quality, gyro_quality) =
+        res.quality(driftless::calib::quality::DEFAULT_WARN_CHI2_PER_DOF);
     let file = CalibrationFile {
         format_version: FORMAT_VERSION,
         method: "six-position".into(),
@@ -458,6 +523,8 @@ fn six(s: SixArgs) -> Result<()> {
             ["up", "samples", "a − g·up (x y z) [m/s²]", "|a| − g [m/s²]"],
             residuals,
         ),
+        &[("accelerometer", &accel_quality), ("gyro", &gyro_quality)],
+        serde_json::json!({}),
     )
 }
 
@@ -472,18 +539,34 @@ fn triad_json(t: &TriadEntry) -> serde_json::Value {
     })
 }
 
+/// Prints the fit-quality warnings (to stderr, so that `--json` stays one document).
+fn warn_quality(quality: &[(&str, &FitQuality)]) {
+    for (name, q) in quality {
+        for w in q.warnings.iter().chain(&q.implausible) {
+            eprintln!("warning: {name} fit: {w}");
+        }
+    }
+}
+
 fn output(
     c: &Common,
     file: &CalibrationFile,
     summary: &[(&str, String)],
     secs: f64,
     residuals: ([&str; 4], Vec<Vec<String>>),
+    quality: &[(&str, &FitQuality)],
+    extra: serde_json::Value,
 ) -> Result<()> {
     if let Some(p) = &c.out {
         file.save(p)?;
     }
+    warn_quality(quality);
     if c.json {
-        let v = serde_json::json!({
+        let mut v = serde_json::json!({
+            "quality": {
+                "accel": serde_json::to_value(quality[0].1)?,
+                "gyro": serde_json::to_value(quality[1].1)?,
+            },
             "method": file.method,
             "gravity_m_s2": file.gravity_m_s2,
             "accel": triad_json(&file.accel),
@@ -493,6 +576,9 @@ fn output(
             "summary": summary.iter().map(|(k, v)| (k.to_string(), v.clone())).collect::<std::collections::BTreeMap<_, _>>(),
             "seconds": secs,
         });
+        if let (Some(obj), serde_json::Value::Object(more)) = (v.as_object_mut(), extra) {
+            obj.extend(more);
+        }
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }

@@ -404,3 +404,69 @@ fn json_contract_matches_stable32() {
         }
     }
 }
+
+/// `allan` on a moving log (a simulated vehicle: stops, turns, vibration) warns on
+/// stderr and in `--json` that the input is not static; a static one of the same noise
+/// does not.
+#[test]
+fn allan_warns_when_the_input_is_not_static() {
+    let noise = |i: usize| {
+        // deterministic pseudo-random, uniform in ±0.01
+        let mut z = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 31)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        ((z >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.02
+    };
+    let log = |moving: bool| {
+        let mut s = String::from("time,gyro_z\n");
+        for i in 0..60_000 {
+            let t = i as f64 * 0.01;
+            let mut w = noise(i);
+            if moving && (t % 120.0) > 20.0 {
+                w += if (t % 30.0) < 5.0 { 0.3 } else { 0.0 };
+                w += 0.05 * (2.0 * std::f64::consts::PI * 13.0 * t).sin();
+            }
+            s.push_str(&format!("{t:.2},{w:.6}\n"));
+        }
+        s
+    };
+    for moving in [false, true] {
+        let path = tmp_file(&format!("allan-moving-{moving}.csv"), &log(moving));
+        let path = path.to_str().unwrap();
+        let out = run(&["allan", path, "--time-column", "time", "--json"]);
+        assert!(out.status.success());
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let warnings = v["warnings"].as_array().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let not_static = warnings.iter().any(|w| {
+            w.as_str()
+                .unwrap()
+                .contains("gyro_z: the input is not static")
+        });
+        assert_eq!(not_static, moving, "{warnings:?}");
+        assert_eq!(stderr.contains("not static"), moving, "{stderr}");
+        if moving {
+            assert!(stderr.contains(path), "{stderr}");
+        }
+    }
+}
+
+/// The real car drive (gyro z in deg/s): not static.
+#[test]
+#[ignore = "needs shared data"]
+fn allan_warns_on_the_real_drive_log() {
+    let p = data_dir().join("drive/drive_0708/imu_1934.csv");
+    let p = p.to_str().unwrap();
+    let out = run(&[
+        "allan", p, "--rate", "100", "--column", "6", "--unit", "deg/s", "--json",
+    ]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    eprintln!("{}", v["warnings"]);
+    assert!(
+        v["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("not static"))
+    );
+}

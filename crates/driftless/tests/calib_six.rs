@@ -584,3 +584,45 @@ fn g_sensitivity_identifiability() {
         );
     }
 }
+
+/// χ²/dof warnings: none on a run whose noise is white (the σ are honest), one naming
+/// the g-sensitivity when the sensor has one and it is not estimated.
+#[test]
+fn chi2_warnings_name_their_likely_causes() {
+    use driftless::calib::quality::DEFAULT_WARN_CHI2_PER_DOF;
+    let ch = chamber();
+    let mut opt = SixPositionOptions::from_manifest(&ch.manifest);
+    opt.estimate_g_sensitivity = false;
+    let mut cfg = flat(Preset::Consumer.config());
+    for n in cfg.gyro.noise.iter_mut().chain(cfg.accel.noise.iter_mut()) {
+        n.bias_instability = 0.0;
+        n.rate_random_walk = 0.0;
+    }
+    let est = run(&ch, &simulate(&ch, &cfg, 17), &opt);
+    let (a, g) = est.quality(DEFAULT_WARN_CHI2_PER_DOF);
+    eprintln!(
+        "white noise: χ²/dof accel {:.2}, gyro {:.2}",
+        a.chi2_per_dof, g.chi2_per_dof
+    );
+    assert!(
+        a.warnings.is_empty() && g.warnings.is_empty(),
+        "{a:?} {g:?}"
+    );
+    assert!(a.chi2_per_dof < DEFAULT_WARN_CHI2_PER_DOF && g.chi2_per_dof.is_finite());
+    // 0.1 °/s per g on every axis pair: 1.8e-4 rad/s per m/s².
+    cfg.gyro.g_sensitivity_rad_s_per_m_s2 = [[1.8e-4; 3]; 3];
+    let est = run(&ch, &simulate(&ch, &cfg, 17), &opt);
+    let (a, g) = est.quality(DEFAULT_WARN_CHI2_PER_DOF);
+    eprintln!(
+        "g-sensitivity not estimated: χ²/dof accel {:.2}, gyro {:.2}: {:?}",
+        a.chi2_per_dof, g.chi2_per_dof, g.warnings
+    );
+    assert!(a.warnings.is_empty(), "{a:?}");
+    assert_eq!(g.warnings.len(), 1, "{g:?}");
+    assert!(g.warnings[0].contains("g-sensitivity"), "{:?}", g.warnings);
+    // Estimated, the warning goes.
+    opt.estimate_g_sensitivity = true;
+    let est = run(&ch, &simulate(&ch, &cfg, 17), &opt);
+    let (_, g) = est.quality(DEFAULT_WARN_CHI2_PER_DOF);
+    assert!(g.warnings.is_empty(), "{g:?}");
+}

@@ -7,6 +7,7 @@
 //! works on phase internally.
 
 pub mod analysis;
+pub mod checks;
 pub mod ci;
 pub mod estimators;
 pub mod fit;

@@ -43,6 +43,21 @@
 //! with P_k = Π_{l≤k} exp([φ_l×]), a perturbation δM_g gives
 //! δû = Rᵀ(u_i × Σ_k P_k δφ_k).
 //!
+//! The starting matrix of the fit is s·I. The isotropic scale s (rad/s per raw unit) is
+//! given, or found from the data: the accelerometer's gravity directions u_i, u_{i+1} at
+//! the ends of move i are θ_i apart, so s ≥ θ_i/L_i with L_i the path length of the raw
+//! bias-removed increments; s is searched on a log grid from half to 20 times the largest
+//! of these bounds for the smallest RMS angle ∠(R(s)ᵀu_i, u_{i+1}), and must be unique
+//! ([`estimate_gyro_scale`]). The gyro axes are taken nominally parallel to the
+//! accelerometer's (the matrix fit removes misalignments of a few degrees).
+//!
+//! # Quality
+//!
+//! [`multi_position_quality`] weights the residuals by the noise the data imply (block
+//! means of each interval, the Allan variance of the initial rest) and gives χ²/dof for
+//! each triad, warnings, and an implausibility verdict: gravity direction after
+//! integrating the gyro beyond a few degrees, or |a| − g far above its noise.
+//!
 //! # Uncertainties
 //!
 //! Every fitted parameter carries the LM covariance σ̂²(JᵀJ)⁻¹ (σ̂² = Σr²/(m − n)); the
@@ -54,6 +69,7 @@ use driftless_model::calib::{ImuCalibration, TriadCalibration};
 use driftless_model::linalg::{Mat3, Vec3, cross, dot, norm, sub};
 
 use super::lsq::{LmOptions, LsqError, levenberg_marquardt};
+use super::quality::FitQuality;
 use super::static_detect::{
     StaticDetectOptions, StaticInterval, intervals_from_profile, variance_profile,
 };
@@ -146,8 +162,21 @@ pub struct MultiPositionOptions {
     /// Fewest static intervals accepted (≥ 10: 9 accelerometer parameters).
     pub min_intervals: usize,
     /// Initial gyro scale, rad/s per raw unit (1 for data already in rad/s; about
-    /// 1/6258 for the Xsens counts of imu_tk). Must be within ≈ 20 % of the truth.
-    pub gyro_scale_guess_rad_s_per_raw: f64,
+    /// 1/6258 for the Xsens counts of imu_tk), within ≈ 20 % of the truth. `None`
+    /// (default): found from the data ([`estimate_gyro_scale`]).
+    pub gyro_scale_guess_rad_s_per_raw: Option<f64>,
+    /// Largest RMS gravity-direction angle the scale search accepts with M_g = s·I, rad
+    /// (default 10°; the matrix fit then removes the misalignments).
+    pub max_scale_search_angle_rad: f64,
+    /// Largest plausible RMS gravity-direction angle after the gyro fit, rad (default
+    /// 3°): above it the result is marked implausible.
+    pub max_gravity_angle_rms_rad: f64,
+    /// Largest plausible accelerometer χ²/dof (default 900: |a| − g residuals 30× their
+    /// noise); above it the result is marked implausible.
+    pub max_accel_chi2_per_dof: f64,
+    /// χ²/dof above which a fit warns (default
+    /// [`super::quality::DEFAULT_WARN_CHI2_PER_DOF`]).
+    pub warn_chi2_per_dof: f64,
     /// Accelerometer rails [min, max] in raw units (e.g. [0, 65535] for a 16-bit ADC); a
     /// static-interval sample at or beyond one is an error. `None`: not checked.
     pub accel_range_raw: Option<[f64; 2]>,
@@ -171,7 +200,11 @@ impl Default for MultiPositionOptions {
             detect: StaticDetectOptions::default(),
             threshold_multiples: (2..=10).map(f64::from).collect(),
             min_intervals: 10,
-            gyro_scale_guess_rad_s_per_raw: 1.0,
+            gyro_scale_guess_rad_s_per_raw: None,
+            max_scale_search_angle_rad: 10f64.to_radians(),
+            max_gravity_angle_rms_rad: 3f64.to_radians(),
+            max_accel_chi2_per_dof: 900.0,
+            warn_chi2_per_dof: super::quality::DEFAULT_WARN_CHI2_PER_DOF,
             accel_range_raw: None,
             gyro_range_raw: None,
             min_direction_spread: 0.5,
@@ -261,6 +294,12 @@ pub struct MultiPositionCalibration {
     /// RMS angle between the gravity direction carried by the calibrated gyro from one
     /// interval to the next and the one measured there, rad.
     pub gravity_angle_rms_rad: f64,
+    /// The gyro scale found from the data (`None` when a guess was given).
+    pub gyro_scale: Option<GyroScaleEstimate>,
+    /// Accelerometer fit quality: χ²/dof of |a_i| − g over the intervals.
+    pub accel_quality: FitQuality,
+    /// Gyro fit quality: χ²/dof of the gravity-direction residuals over the moves.
+    pub gyro_quality: FitQuality,
 }
 
 impl MultiPositionCalibration {
@@ -524,13 +563,20 @@ fn rot_exp(phi: Vec3) -> Mat3 {
 
 /// One move between static intervals, prepared for the gyro fit.
 struct Move {
-    /// Bias-removed, guess-scaled trapezoidal rate × dt per step (rad at G = I).
+    /// Bias-removed trapezoidal raw increment ((raw_k + raw_{k+1})/2 − b_g)·Δt per step,
+    /// raw·s; multiplied by the scale in use before the matrix fit.
     w: Vec<Vec3>,
     /// Calibrated gravity direction at the start.
     u0: Vec3,
+    /// Measured gravity direction at the end.
+    u1: Vec3,
     /// Basis of the plane ⟂ the measured direction at the end.
     e1: Vec3,
     e2: Vec3,
+    /// Σ_k ‖w_k‖ (the path length of the raw increments), raw·s.
+    path_raw_s: f64,
+    /// |Σ_k w_k| per axis, raw·s.
+    net_raw_s: Vec3,
 }
 
 fn perp_basis(u: Vec3) -> (Vec3, Vec3) {
@@ -543,6 +589,10 @@ fn perp_basis(u: Vec3) -> (Vec3, Vec3) {
     let n1 = norm(e1);
     let e1 = e1.map(|v| v / n1);
     (e1, cross(u, e1))
+}
+
+fn angle_between(a: Vec3, b: Vec3) -> f64 {
+    norm(cross(a, b)).atan2(dot(a, b))
 }
 
 /// Carries u0 through the move with G; returns the predicted direction Rᵀu0 and, when
@@ -576,19 +626,20 @@ fn carry(g: &Mat3, mv: &Move, want_jac: bool) -> (Vec3, [Vec3; 9]) {
     (pred, d)
 }
 
-/// Gyro fit of the module equations. `intervals` must come from the same log (their
-/// sample ranges index `time_s` and `gyro_raw`), the first being the initial rest;
-/// `accel` calibrates the interval means to gravity directions.
-pub fn calibrate_gyro(
+/// The gyro bias from the initial rest and the moves between static intervals.
+struct GyroPrep {
+    bias: Vec3,
+    bias_var: Vec3,
+    moves: Vec<Move>,
+}
+
+fn prepare_gyro(
     time_s: &[f64],
     gyro_raw: &[Vec3],
     intervals: &[StaticInterval],
     accel: &TriadCalibration,
     opts: &MultiPositionOptions,
-) -> Result<TriadFit, CalibError> {
-    const NAMES: [&str; 12] = [
-        "bias x", "bias y", "bias z", "M00", "M01", "M02", "M10", "M11", "M12", "M20", "M21", "M22",
-    ];
+) -> Result<GyroPrep, CalibError> {
     let n = gyro_raw.len();
     if time_s.len() != n {
         return Err(CalibError::BadInput(format!(
@@ -607,16 +658,13 @@ pub fn calibrate_gyro(
             "a static interval lies outside the gyro log".into(),
         ));
     }
-    let s0 = opts.gyro_scale_guess_rad_s_per_raw;
-    if !(s0 > 0.0 && s0.is_finite()) {
-        return Err(CalibError::BadInput(format!("gyro scale guess {s0}")));
-    }
-    if gyro_raw[..intervals[intervals.len() - 1].end]
-        .iter()
-        .flatten()
-        .any(|v| !v.is_finite())
-    {
-        return Err(CalibError::BadInput("non-finite gyro sample".into()));
+    let last_end = intervals[intervals.len() - 1].end;
+    if let Some(k) = (0..last_end).find(|&k| gyro_raw[k].iter().any(|v| !v.is_finite())) {
+        return Err(CalibError::BadInput(format!(
+            "non-finite gyro sample at {:.3} s (sample {}): remove or repair that row",
+            time_s[k],
+            k + 1
+        )));
     }
     // Rails: the rest and every move.
     if let Some([lo, hi]) = opts.gyro_range_raw {
@@ -644,48 +692,298 @@ pub fn calibrate_gyro(
         }
     }
     let nb = 10.min(len / 2).max(2);
-    let bl = len / nb;
+    let bl = (len / nb).max(1);
     let mut bias_var = [0.0; 3];
     for b in 0..nb {
-        let seg = &gyro_raw[rest.start + b * bl..rest.start + (b + 1) * bl];
+        let seg = &gyro_raw[rest.start + b * bl..(rest.start + (b + 1) * bl).min(rest.end)];
         for j in 0..3 {
-            let m = seg.iter().map(|w| w[j]).sum::<f64>() / bl as f64;
+            let m = seg.iter().map(|w| w[j]).sum::<f64>() / seg.len().max(1) as f64;
             bias_var[j] += (m - bias[j]).powi(2) / ((nb - 1) as f64 * nb as f64);
         }
     }
-    // Moves.
-    let mut moves = Vec::with_capacity(intervals.len() - 1);
-    let mut net = [0.0; 3];
     let dir = |iv: &StaticInterval| {
         let a = accel.apply(iv.mean_accel_raw);
         let nn = norm(a).max(1e-300);
         a.map(|v| v / nn)
     };
+    let mut moves = Vec::with_capacity(intervals.len() - 1);
     for pair in intervals.windows(2) {
         let (a, b) = (&pair[0], &pair[1]);
         let (k0, k1) = (a.end - 1, b.start);
         let mut w = Vec::with_capacity(k1.saturating_sub(k0));
         let mut tot = [0.0; 3];
+        let mut path = 0.0;
         for k in k0..k1 {
             let dt = time_s[k + 1] - time_s[k];
-            let v: Vec3 = [0, 1, 2]
-                .map(|j| (0.5 * (gyro_raw[k][j] + gyro_raw[k + 1][j]) - bias[j]) * s0 * dt);
+            let v: Vec3 =
+                [0, 1, 2].map(|j| (0.5 * (gyro_raw[k][j] + gyro_raw[k + 1][j]) - bias[j]) * dt);
             for j in 0..3 {
                 tot[j] += v[j];
             }
+            path += norm(v);
             w.push(v);
-        }
-        for j in 0..3 {
-            net[j] += tot[j].abs();
         }
         let u1 = dir(b);
         let (e1, e2) = perp_basis(u1);
         moves.push(Move {
             w,
             u0: dir(a),
+            u1,
             e1,
             e2,
+            path_raw_s: path,
+            net_raw_s: tot.map(f64::abs),
         });
+    }
+    Ok(GyroPrep {
+        bias,
+        bias_var,
+        moves,
+    })
+}
+
+/// The isotropic gyro scale s (rad/s per raw unit) found from the data; see
+/// [`estimate_gyro_scale`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct GyroScaleEstimate {
+    /// s, rad/s per raw unit.
+    pub scale_rad_s_per_raw: f64,
+    /// RMS gravity-direction angle over the moves with M_g = s·I, rad.
+    pub gravity_angle_rms_rad: f64,
+    /// The best other scale (a separate minimum more than 15 % away) and its RMS angle,
+    /// rad: how clearly the data single out s.
+    pub runner_up: Option<(f64, f64)>,
+    /// Moves that tilt the gravity direction by at least 10°.
+    pub tilting_moves: usize,
+}
+
+/// Smallest gravity-direction change of a move that bounds the scale, rad.
+const MIN_TILT_RAD: f64 = 10.0 * std::f64::consts::PI / 180.0;
+
+fn scale_cost(moves: &[Move], s: f64) -> f64 {
+    let g = Mat3::diag([s; 3]);
+    let sum: f64 = moves
+        .iter()
+        .map(|mv| angle_between(carry(&g, mv, false).0, mv.u1).powi(2))
+        .sum();
+    (sum / moves.len().max(1) as f64).sqrt()
+}
+
+fn span(intervals: &[StaticInterval], i: usize) -> String {
+    format!(
+        "{:.2}–{:.2} s",
+        intervals[i].end_time_s,
+        intervals[i + 1].start_time_s
+    )
+}
+
+/// Scale search over the prepared moves (raw increments).
+///
+/// The gravity directions u_i, u_{i+1} measured by the accelerometer at the ends of move i
+/// are θ_i = ∠(u_i, u_{i+1}) apart; the sensor turned by at least θ_i, and by at most
+/// s·L_i, L_i = Σ_k ‖w_k‖ the path length of the raw increments. So s ≥ θ_i / L_i for
+/// every move, and s is searched on a 2 % log grid over [½, 20]·max_i θ_i/L_i (moves with
+/// θ_i ≥ 10°) for the smallest RMS over the moves of ∠(R(s)ᵀu_i, u_{i+1}) with
+/// R(s) = Π_k exp([s·w_k ×]), then refined by golden section. Moves of different angles
+/// alias at different scales (a turn by θ about one axis is also matched by
+/// s' = s·(1 + 2πk/θ)), so the global minimum is unique when the moves differ; a second
+/// minimum more than 15 % away with less than twice the best RMS angle is an error.
+fn search_scale(
+    moves: &[Move],
+    intervals: &[StaticInterval],
+    opts: &MultiPositionOptions,
+) -> Result<GyroScaleEstimate, CalibError> {
+    let tilts: Vec<f64> = moves.iter().map(|m| angle_between(m.u0, m.u1)).collect();
+    let total: f64 = tilts.iter().sum();
+    let tilting: Vec<usize> = (0..moves.len())
+        .filter(|&i| tilts[i] >= MIN_TILT_RAD)
+        .collect();
+    if total < opts.min_rotation_rad || tilting.len() < 3 {
+        return Err(CalibError::Unobservable {
+            sensor: "gyro",
+            parameter: "scale".into(),
+            reason: format!(
+                "the gravity direction turns by only {:.1}° in total over {} moves ({} of them by 10° or more; need {:.0}° and 3 such moves), so the rotations cannot fix the gyro scale: tilt the sensor between poses (about horizontal axes), or set the gyro scale guess",
+                total.to_degrees(),
+                moves.len(),
+                tilting.len(),
+                opts.min_rotation_rad.to_degrees()
+            ),
+        });
+    }
+    if let Some(&i) = tilting.iter().find(|&&i| moves[i].path_raw_s <= 0.0) {
+        return Err(CalibError::Unobservable {
+            sensor: "gyro",
+            parameter: "scale".into(),
+            reason: format!(
+                "the gyro reads no rotation over {} although the gravity direction turns by {:.1}° there: check that the gyro log was recorded with the accelerometer log (same time base)",
+                span(intervals, i),
+                tilts[i].to_degrees()
+            ),
+        });
+    }
+    let bound = tilting
+        .iter()
+        .map(|&i| tilts[i] / moves[i].path_raw_s)
+        .fold(0.0, f64::max);
+    let (lo, hi) = ((0.5 * bound).ln(), (20.0 * bound).ln());
+    let step = 0.02f64;
+    let n = ((hi - lo) / step).ceil() as usize + 1;
+    let grid: Vec<f64> = (0..n).map(|i| lo + step * i as f64).collect();
+    let cost: Vec<f64> = grid.iter().map(|&l| scale_cost(moves, l.exp())).collect();
+    let ibest = (0..n)
+        .min_by(|&a, &b| cost[a].total_cmp(&cost[b]))
+        .unwrap_or(0);
+    // Golden section on ln s around the grid minimum.
+    let (mut a, mut b) = (grid[ibest] - step, grid[ibest] + step);
+    let phi = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - phi * (b - a), a + phi * (b - a));
+    let (mut fc, mut fd) = (scale_cost(moves, c.exp()), scale_cost(moves, d.exp()));
+    for _ in 0..30 {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - phi * (b - a);
+            fc = scale_cost(moves, c.exp());
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + phi * (b - a);
+            fd = scale_cost(moves, d.exp());
+        }
+    }
+    let (l_best, f_best) = if fc < fd { (c, fc) } else { (d, fd) };
+    let (l_best, f_best) = if f_best <= cost[ibest] {
+        (l_best, f_best)
+    } else {
+        (grid[ibest], cost[ibest])
+    };
+    let runner_up = (0..n)
+        .filter(|&i| {
+            (grid[i] - l_best).abs() > 0.15
+                && (i == 0 || cost[i] <= cost[i - 1])
+                && (i + 1 == n || cost[i] <= cost[i + 1])
+        })
+        .min_by(|&a, &b| cost[a].total_cmp(&cost[b]))
+        .map(|i| (grid[i].exp(), cost[i]));
+    let s = l_best.exp();
+    if ibest == 0 || ibest + 1 == n {
+        return Err(CalibError::Unobservable {
+            sensor: "gyro",
+            parameter: "scale".into(),
+            reason: format!(
+                "the best scale lies at the edge of the searched range {:.4e}…{:.4e} rad/s per raw unit (RMS gravity angle {:.2}°): the moves' rotations do not fit the gravity directions; check the gyro log's time base and axes, or set the gyro scale guess",
+                grid[0].exp(),
+                grid[n - 1].exp(),
+                f_best.to_degrees()
+            ),
+        });
+    }
+    if f_best > opts.max_scale_search_angle_rad {
+        return Err(CalibError::Unobservable {
+            sensor: "gyro",
+            parameter: "scale".into(),
+            reason: format!(
+                "no single scale makes the integrated gyro carry the gravity direction from pose to pose (best {:.4e} rad/s per raw unit leaves an RMS angle of {:.1}°, limit {:.1}°): check that the gyro log was recorded with the accelerometer log (same time base), that its axes match the accelerometer's, and that it is not clipped during the moves; or set the gyro scale guess",
+                s,
+                f_best.to_degrees(),
+                opts.max_scale_search_angle_rad.to_degrees()
+            ),
+        });
+    }
+    if let Some((s2, f2)) = runner_up
+        && f2 < 2.0 * f_best
+    {
+        return Err(CalibError::Unobservable {
+            sensor: "gyro",
+            parameter: "scale".into(),
+            reason: format!(
+                "two gyro scales fit the moves about equally well ({s:.4e} rad/s per raw unit: RMS {:.2}°; {s2:.4e}: {:.2}°), so the rotations do not single one out: add moves of different sizes about different axes, or set the gyro scale guess",
+                f_best.to_degrees(),
+                f2.to_degrees()
+            ),
+        });
+    }
+    Ok(GyroScaleEstimate {
+        scale_rad_s_per_raw: s,
+        gravity_angle_rms_rad: f_best,
+        runner_up,
+        tilting_moves: tilting.len(),
+    })
+}
+
+/// Finds the gyro scale s (rad/s per raw unit) of a multi-position log from the data: the
+/// accelerometer fixes the tilt between consecutive static intervals, the integrated raw
+/// gyro gives the same rotation in raw units (see the search in the module source:
+/// bounds s ≥ θ_i/L_i, log grid, golden section, uniqueness check). Errors when the
+/// moves cannot identify it: too little tilt in total, no rotation read by the gyro while
+/// gravity turns, no scale that fits (wrong log, axes or clipping), or two scales that
+/// fit alike.
+pub fn estimate_gyro_scale(
+    time_s: &[f64],
+    gyro_raw: &[Vec3],
+    intervals: &[StaticInterval],
+    accel: &TriadCalibration,
+    opts: &MultiPositionOptions,
+) -> Result<GyroScaleEstimate, CalibError> {
+    let prep = prepare_gyro(time_s, gyro_raw, intervals, accel, opts)?;
+    search_scale(&prep.moves, intervals, opts)
+}
+
+/// Gyro fit of the module equations. `intervals` must come from the same log (their
+/// sample ranges index `time_s` and `gyro_raw`), the first being the initial rest;
+/// `accel` calibrates the interval means to gravity directions. The starting matrix is
+/// s·I with s = [`MultiPositionOptions::gyro_scale_guess_rad_s_per_raw`], or, when that
+/// is `None`, the scale found by [`estimate_gyro_scale`].
+pub fn calibrate_gyro(
+    time_s: &[f64],
+    gyro_raw: &[Vec3],
+    intervals: &[StaticInterval],
+    accel: &TriadCalibration,
+    opts: &MultiPositionOptions,
+) -> Result<TriadFit, CalibError> {
+    gyro_fit(time_s, gyro_raw, intervals, accel, opts).map(|(fit, _)| fit)
+}
+
+fn gyro_fit(
+    time_s: &[f64],
+    gyro_raw: &[Vec3],
+    intervals: &[StaticInterval],
+    accel: &TriadCalibration,
+    opts: &MultiPositionOptions,
+) -> Result<(TriadFit, Option<GyroScaleEstimate>), CalibError> {
+    const NAMES: [&str; 12] = [
+        "bias x", "bias y", "bias z", "M00", "M01", "M02", "M10", "M11", "M12", "M20", "M21", "M22",
+    ];
+    if let Some(s0) = opts.gyro_scale_guess_rad_s_per_raw
+        && !(s0 > 0.0 && s0.is_finite())
+    {
+        return Err(CalibError::BadInput(format!(
+            "gyro scale guess {s0}: give a positive rad/s per raw unit, or none to find it from the data"
+        )));
+    }
+    let GyroPrep {
+        bias,
+        bias_var,
+        mut moves,
+    } = prepare_gyro(time_s, gyro_raw, intervals, accel, opts)?;
+    let (s0, estimate) = match opts.gyro_scale_guess_rad_s_per_raw {
+        Some(s0) => (s0, None),
+        None => {
+            let e = search_scale(&moves, intervals, opts)?;
+            (e.scale_rad_s_per_raw, Some(e))
+        }
+    };
+    let mut net = [0.0; 3];
+    for mv in &mut moves {
+        for w in &mut mv.w {
+            *w = w.map(|v| v * s0);
+        }
+        for (n, r) in net.iter_mut().zip(mv.net_raw_s) {
+            *n += r * s0;
+        }
     }
     for j in 0..3 {
         if net[j] < opts.min_rotation_rad {
@@ -741,15 +1039,47 @@ pub fn calibrate_gyro(
             [gm[6], gm[7], gm[8]],
         ]),
     };
-    Ok(TriadFit {
-        calibration,
-        param_names: NAMES.to_vec(),
-        params,
-        param_covariance: cov.clone(),
-        bm_covariance: cov,
-        residual_rms: fit.rms,
-        iterations: fit.iterations,
-    })
+    Ok((
+        TriadFit {
+            calibration,
+            param_names: NAMES.to_vec(),
+            params,
+            param_covariance: cov.clone(),
+            bm_covariance: cov,
+            residual_rms: fit.rms,
+            iterations: fit.iterations,
+        },
+        estimate,
+    ))
+}
+
+/// For each move, the gravity direction at its start carried by the calibrated gyro to
+/// its end, R_iᵀu_i, and the one measured there, u_{i+1} (both unit vectors).
+fn carried_directions(
+    time_s: &[f64],
+    gyro_raw: &[Vec3],
+    intervals: &[StaticInterval],
+    cal: &ImuCalibration,
+) -> Vec<(Vec3, Vec3)> {
+    let dir = |iv: &StaticInterval| {
+        let a = cal.accel.apply(iv.mean_accel_raw);
+        let nn = norm(a).max(1e-300);
+        a.map(|v| v / nn)
+    };
+    intervals
+        .windows(2)
+        .map(|pair| {
+            let (a, b) = (&pair[0], &pair[1]);
+            let mut p = Mat3::IDENTITY;
+            for k in (a.end - 1)..b.start {
+                let dt = time_s[k + 1] - time_s[k];
+                let w0 = cal.gyro.apply(gyro_raw[k]);
+                let w1 = cal.gyro.apply(gyro_raw[k + 1]);
+                p = p.mul_mat(&rot_exp([0, 1, 2].map(|j| 0.5 * (w0[j] + w1[j]) * dt)));
+            }
+            (p.t().mul_vec(dir(a)), dir(b))
+        })
+        .collect()
 }
 
 /// RMS angle (rad) between the gravity direction carried by the calibrated gyro across
@@ -760,29 +1090,170 @@ pub fn gravity_angle_rms(
     intervals: &[StaticInterval],
     cal: &ImuCalibration,
 ) -> f64 {
-    let mut s = 0.0;
-    let mut count = 0usize;
-    let dir = |iv: &StaticInterval| {
-        let a = cal.accel.apply(iv.mean_accel_raw);
-        let nn = norm(a).max(1e-300);
-        a.map(|v| v / nn)
-    };
-    for pair in intervals.windows(2) {
-        let (a, b) = (&pair[0], &pair[1]);
-        let mut p = Mat3::IDENTITY;
-        for k in (a.end - 1)..b.start {
-            let dt = time_s[k + 1] - time_s[k];
-            let w0 = cal.gyro.apply(gyro_raw[k]);
-            let w1 = cal.gyro.apply(gyro_raw[k + 1]);
-            p = p.mul_mat(&rot_exp([0, 1, 2].map(|j| 0.5 * (w0[j] + w1[j]) * dt)));
-        }
-        let pred = p.t().mul_vec(dir(a));
-        let meas = dir(b);
-        let ang = norm(cross(pred, meas)).atan2(dot(pred, meas));
-        s += ang * ang;
-        count += 1;
+    let pairs = carried_directions(time_s, gyro_raw, intervals, cal);
+    let s: f64 = pairs
+        .iter()
+        .map(|(p, m)| angle_between(*p, *m).powi(2))
+        .sum();
+    (s / pairs.len().max(1) as f64).sqrt()
+}
+
+/// Variance of the mean of `x` from 10 block means: Σ_b (x̄_b − x̄)² / (n_b(n_b − 1)).
+fn mean_variance(x: &[f64]) -> f64 {
+    let len = x.len();
+    let nb = 10.min(len / 2).max(2);
+    let bl = (len / nb).max(1);
+    let nb = (len / bl).max(1);
+    let used = &x[..nb * bl];
+    let mean = used.iter().sum::<f64>() / used.len().max(1) as f64;
+    let ss: f64 = used
+        .chunks(bl)
+        .map(|c| (c.iter().sum::<f64>() / bl as f64 - mean).powi(2))
+        .sum();
+    ss / ((nb * nb.saturating_sub(1)).max(1)) as f64
+}
+
+/// Overlapping Allan variance per axis of `x` at an averaging length of `len` samples,
+/// ½⟨(x̄_{k+len} − x̄_k)²⟩ (IEEE Std 952 Annex C); `None` when `x` holds fewer than three
+/// such lengths.
+fn allan_variance_at(x: &[Vec3], len: usize) -> Option<Vec3> {
+    let n = x.len();
+    if len == 0 || n < 3 * len {
+        return None;
     }
-    (s / count.max(1) as f64).sqrt()
+    let mut cum = vec![[0.0; 3]; n + 1];
+    for (k, v) in x.iter().enumerate() {
+        cum[k + 1] = [0, 1, 2].map(|j| cum[k][j] + v[j]);
+    }
+    let count = n + 1 - 2 * len;
+    let mut out = [0.0; 3];
+    for k in 0..count {
+        for j in 0..3 {
+            let a = (cum[k + len][j] - cum[k][j]) / len as f64;
+            let b = (cum[k + 2 * len][j] - cum[k + len][j]) / len as f64;
+            out[j] += 0.5 * (b - a).powi(2) / count as f64;
+        }
+    }
+    Some(out)
+}
+
+const ACCEL_CAUSES: &str = "motion or vibration inside the static intervals, accelerometer nonlinearity or temperature drift during the recording, a wrong local gravity, or noise more correlated than the block means of each interval show";
+const GYRO_CAUSES: &str = "gyro bias drift after the initial rest, a time offset between the gyro and accelerometer logs or irregular time stamps, moves too fast for the sample rate or clipped, or gyro g-sensitivity";
+
+/// The noise-weighted quality figures of a multi-position calibration.
+///
+/// Accelerometer: r_i = ‖a_i‖ − g per static interval, σ_i² the variance of the interval
+/// mean of u_i·a_k (calibrated samples projected on the interval's gravity direction u_i):
+/// the larger of its value from 10 block means of the interval and Σ_j u_ij² σ²_A,j(τ_i),
+/// the Allan variance of the calibrated accelerometer over the initial rest at the
+/// interval's length τ_i (it carries the bias wander between intervals that the scatter
+/// inside one interval misses); χ² = Σ r_i²/σ_i², ν = m − 9. Implausible above
+/// [`MultiPositionOptions::max_accel_chi2_per_dof`].
+///
+/// Gyro: per move, the two components ⟂ u_{i+1} of the carried direction R_iᵀu_i
+/// ([`gravity_angle_rms`]); each with σ² = (σ⊥,i² + σ⊥,i+1²)/g² + σ_ω²·Δt·T_i + σ_b²·T_i²,
+/// σ⊥ the σ of an interval's mean across gravity (as above, average of two axes), σ_ω
+/// the per-sample σ of the calibrated gyro over the initial rest (average over the axes),
+/// σ_b the σ of the calibrated bias, T_i the move's duration, Δt the sample interval;
+/// ν = 2(m − 1) − 9. Implausible when the RMS gravity angle exceeds
+/// [`MultiPositionOptions::max_gravity_angle_rms_rad`].
+#[allow(clippy::too_many_arguments)]
+pub fn multi_position_quality(
+    time_s: &[f64],
+    accel_raw: &[Vec3],
+    gyro_raw: &[Vec3],
+    intervals: &[StaticInterval],
+    cal: &ImuCalibration,
+    gyro_bias_sigma_raw: Vec3,
+    opts: &MultiPositionOptions,
+) -> (FitQuality, FitQuality) {
+    let g = opts.gravity_m_s2;
+    let rest = &intervals[0];
+    let rest_accel: Vec<Vec3> = accel_raw[rest.start..rest.end]
+        .iter()
+        .map(|r| cal.accel.apply(*r))
+        .collect();
+    let mut chi2_a = 0.0;
+    let mut perp_var = Vec::with_capacity(intervals.len());
+    for iv in intervals {
+        let avar = allan_variance_at(&rest_accel, iv.len()).unwrap_or([0.0; 3]);
+        let floor = |e: Vec3| (0..3).map(|j| e[j] * e[j] * avar[j]).sum::<f64>();
+        let a_mean = cal.accel.apply(iv.mean_accel_raw);
+        let n = norm(a_mean).max(1e-300);
+        let u = a_mean.map(|v| v / n);
+        let (e1, e2) = perp_basis(u);
+        let cal_k: Vec<Vec3> = accel_raw[iv.start..iv.end]
+            .iter()
+            .map(|r| cal.accel.apply(*r))
+            .collect();
+        let proj = |e: Vec3| -> Vec<f64> { cal_k.iter().map(|a| dot(e, *a)).collect() };
+        let var_u = mean_variance(&proj(u)).max(floor(u));
+        perp_var.push(
+            0.5 * (mean_variance(&proj(e1)).max(floor(e1))
+                + mean_variance(&proj(e2)).max(floor(e2))),
+        );
+        chi2_a += (n - g).powi(2) / var_u.max(1e-300);
+    }
+    let mut accel_q = FitQuality::from_chi2(
+        chi2_a,
+        intervals.len().saturating_sub(9),
+        opts.warn_chi2_per_dof,
+        ACCEL_CAUSES,
+    );
+    let rms_a = accel_norm_rms(intervals, &cal.accel, g);
+    if accel_q.chi2_per_dof > opts.max_accel_chi2_per_dof {
+        accel_q.implausible.push(format!(
+            "RMS |a| − g {rms_a:.5} m/s² is {:.0}× its noise (χ²/dof {:.0}, limit {}): the accelerometer model does not fit these poses; check the local gravity, that the static intervals are really static, and that no axis is clipped",
+            accel_q.chi2_per_dof.sqrt(),
+            accel_q.chi2_per_dof,
+            opts.max_accel_chi2_per_dof
+        ));
+    }
+    // Gyro noise over the rest.
+    let w: Vec<Vec3> = gyro_raw[rest.start..rest.end]
+        .iter()
+        .map(|r| cal.gyro.apply(*r))
+        .collect();
+    let nw = w.len().max(2) as f64;
+    let mut var_w = 0.0;
+    for j in 0..3 {
+        let m = w.iter().map(|v| v[j]).sum::<f64>() / nw;
+        var_w += w.iter().map(|v| (v[j] - m).powi(2)).sum::<f64>() / (nw - 1.0) / 3.0;
+    }
+    let mm = cal.gyro.matrix.0;
+    let var_b: f64 = (0..3)
+        .map(|j| {
+            (0..3)
+                .map(|l| (mm[j][l] * gyro_bias_sigma_raw[l]).powi(2))
+                .sum::<f64>()
+        })
+        .sum::<f64>()
+        / 3.0;
+    let pairs = carried_directions(time_s, gyro_raw, intervals, cal);
+    let mut chi2_g = 0.0;
+    for (i, (pred, meas)) in pairs.iter().enumerate() {
+        let (e1, e2) = perp_basis(*meas);
+        let (a, b) = (&intervals[i], &intervals[i + 1]);
+        let t = time_s[b.start] - time_s[a.end - 1];
+        let dt = t / (b.start + 1 - a.end).max(1) as f64;
+        let var = (perp_var[i] + perp_var[i + 1]) / (g * g) + var_w * dt * t + var_b * t * t;
+        chi2_g += (dot(e1, *pred).powi(2) + dot(e2, *pred).powi(2)) / var.max(1e-300);
+    }
+    let mut gyro_q = FitQuality::from_chi2(
+        chi2_g,
+        (2 * pairs.len()).saturating_sub(9),
+        opts.warn_chi2_per_dof,
+        GYRO_CAUSES,
+    );
+    let ang = gravity_angle_rms(time_s, gyro_raw, intervals, cal);
+    if ang > opts.max_gravity_angle_rms_rad {
+        gyro_q.implausible.push(format!(
+            "the gravity direction after integrating the gyro is off by {:.3}° RMS (limit {:.1}°): the gyro scale or axes are wrong; check the gyro log's units and scale (raw counts need the scale found from the data or given), that it was recorded with the accelerometer log, and that it is not clipped during the moves",
+            ang.to_degrees(),
+            opts.max_gravity_angle_rms_rad.to_degrees()
+        ));
+    }
+    (accel_q, gyro_q)
 }
 
 /// The whole multi-position calibration of a log that starts at rest: static detection
@@ -852,11 +1323,20 @@ pub fn calibrate_multi_position(
             needed,
         }));
     };
-    let gyro = calibrate_gyro(time_s, gyro_raw, &intervals, &accel.calibration, opts)?;
+    let (gyro, gyro_scale) = gyro_fit(time_s, gyro_raw, &intervals, &accel.calibration, opts)?;
     let cal = ImuCalibration {
         accel: accel.calibration,
         gyro: gyro.calibration,
     };
+    let (accel_quality, gyro_quality) = multi_position_quality(
+        time_s,
+        accel_raw,
+        gyro_raw,
+        &intervals,
+        &cal,
+        gyro.bias_sigma(),
+        opts,
+    );
     Ok(MultiPositionCalibration {
         accel_norm_rms_m_s2: accel_norm_rms(&intervals, &cal.accel, opts.gravity_m_s2),
         gravity_angle_rms_rad: gravity_angle_rms(time_s, gyro_raw, &intervals, &cal),
@@ -865,6 +1345,9 @@ pub fn calibrate_multi_position(
         sweep,
         accel,
         gyro,
+        gyro_scale,
+        accel_quality,
+        gyro_quality,
     })
 }
 

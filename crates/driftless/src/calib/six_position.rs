@@ -95,6 +95,7 @@ use driftless_model::calib::{ImuCalibration, TriadCalibration};
 use driftless_model::linalg::{Mat3, Vec3};
 
 use super::lsq::{self, LsqError};
+use super::quality::FitQuality;
 use crate::nav::earth;
 use crate::sim::chamber::{BodyAxis, ChamberManifest, SegmentKind, SignedAxis};
 use crate::sim::sensor::{OutputKind, SensorOutput};
@@ -400,6 +401,35 @@ impl SixPositionCalibration {
             accel: self.accel.calibration,
             gyro: self.gyro.calibration,
         }
+    }
+
+    /// χ²/dof of both triads' noise-weighted residuals (σ = sample σ/√n of each position
+    /// or rate segment), each with a warning and its likely causes above
+    /// `warn_chi2_per_dof` (e.g. [`super::quality::DEFAULT_WARN_CHI2_PER_DOF`]). The
+    /// covariances are already inflated by χ²/dof when it exceeds 1; the warning says
+    /// the residuals are not white noise.
+    pub fn quality(&self, warn_chi2_per_dof: f64) -> (FitQuality, FitQuality) {
+        let common = "noise more correlated than σ/√n assumes (bias instability or rate random walk over long dwells), motion or vibration during a segment, segments whose times or orientations are not the manifest's, or temperature drift during the run";
+        let accel = FitQuality::from_chi2(
+            self.accel.chi2,
+            self.accel.dof,
+            warn_chi2_per_dof,
+            &format!("{common}, or accelerometer nonlinearity"),
+        );
+        let g_sens = if self.gyro_g_sensitivity.is_none() {
+            ", gyro g-sensitivity (not estimated: estimate it)"
+        } else {
+            ""
+        };
+        let gyro = FitQuality::from_chi2(
+            self.gyro.chi2,
+            self.gyro.dof,
+            warn_chi2_per_dof,
+            &format!(
+                "{common}, rate-table rates or site latitude (Earth rate) other than given{g_sens}"
+            ),
+        );
+        (accel, gyro)
     }
 }
 
