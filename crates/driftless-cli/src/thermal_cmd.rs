@@ -165,6 +165,21 @@ pub fn run(a: ThermalArgs) -> Result<()> {
     }
 }
 
+/// What the "scatter/σ" column means.
+const SCATTER_NOTE: &str = "scatter/σ: √(χ²/dof) of the points against their own σ; where \
+     above 1 the σ and bands are scaled by it (×), so they match the scatter seen";
+
+/// "1.23 ×" when the σ were scaled by the scatter, "0.87" when not, "–" without σ.
+fn scatter_cell(f: &driftless::thermal::ThermalFit) -> String {
+    match f.scatter_ratio {
+        Some(r) if f.noise_scale == driftless::thermal::NoiseScale::Inflated => {
+            format!("{r:.2} ×")
+        }
+        Some(r) => format!("{r:.2}"),
+        None => "–".into(),
+    }
+}
+
 /// Every IMU instance of `path` with its label: all instances of an autopilot log, or
 /// the one log of a text / DRIFTLOG file. Gaps are bridged (and reported by the check)
 /// unless `--gaps` asks otherwise.
@@ -459,6 +474,9 @@ fn soak(s: SoakArgs) -> Result<()> {
                     "triad": x.triad, "quantity": x.quantity, "axis": (["x", "y", "z"][x.axis]),
                     "coefficients": x.fit.coeffs, "std_errors": x.fit.std_errors,
                     "residual_rms": x.fit.residual_rms, "chi2_per_dof": x.fit.chi2_per_dof,
+                    // √(χ²/dof) of the points against their σ, and the factor applied
+                    // to the σ (≥ 1: the bands follow the scatter seen)
+                    "scatter_ratio": x.fit.scatter_ratio, "sigma_scale": x.fit.sigma_scale,
                 })
             })
             .collect();
@@ -490,6 +508,7 @@ fn soak(s: SoakArgs) -> Result<()> {
     let mut head = vec!["series".to_string()];
     head.extend((0..=s.order).map(|k| format!("c{k} ± σ")));
     head.push("resid. RMS".into());
+    head.push("scatter/σ".into());
     let mut tab = crate::output::Table::new(head);
     for x in &soak.series {
         let mut row = vec![format!(
@@ -506,11 +525,13 @@ fn soak(s: SoakArgs) -> Result<()> {
             ));
         }
         row.push(crate::output::sci(x.fit.residual_rms));
+        row.push(scatter_cell(&x.fit));
         tab.row(row);
     }
     print!("{}", tab.render());
+    println!("{SCATTER_NOTE}");
     if let Some(g) = &g_mean {
-        // Estimated per step (rate segments all +k up); not part of the model file.
+        // Estimated per step (rate segments all +k up); the model file carries the mean.
         let d = |i: usize| {
             format!(
                 "{} ± {}",
@@ -631,6 +652,7 @@ fn ramp(r: RampArgs) -> Result<()> {
                 serde_json::json!({
                     "channel": n, "coefficients": f.coeffs, "std_errors": f.std_errors,
                     "residual_rms": f.residual_rms,
+                    "scatter_ratio": f.scatter_ratio, "sigma_scale": f.sigma_scale,
                     "hysteresis_rms": res.hysteresis.as_ref().map(|h| h[k]),
                 })
             })
@@ -658,6 +680,7 @@ fn ramp(r: RampArgs) -> Result<()> {
     let mut head = vec!["channel".to_string()];
     head.extend((0..=r.order).map(|k| format!("c{k} ± σ")));
     head.push("hysteresis RMS".into());
+    head.push("scatter/σ".into());
     let mut tab = crate::output::Table::new(head);
     for (k, (n, f)) in res.names.iter().zip(&res.fits).enumerate() {
         let mut row = vec![n.clone()];
@@ -673,9 +696,11 @@ fn ramp(r: RampArgs) -> Result<()> {
                 .as_ref()
                 .map_or("–".into(), |h| crate::output::sci(h[k])),
         );
+        row.push(scatter_cell(f));
         tab.row(row);
     }
     print!("{}", tab.render());
+    println!("{SCATTER_NOTE}");
     if let Some(p) = &r.out {
         println!("wrote {} (bias-only model)", p.display());
     }
