@@ -347,3 +347,55 @@ fn out_of_range_spans_name_time_and_temperature() {
     assert!(e[1].describe().contains("5.0–8.0 s"), "{}", e[1].describe());
     assert!(out_of_range_spans(None, 0.5, &[22.0, 23.0], [21.0, 29.0]).is_empty());
 }
+
+/// The product's simulator: a consumer IMU (every noise term) warming 20 → 60 °C and
+/// cooling back at an uneven rate, its temperature read in 1 °C steps (the ramp of
+/// `tests/thermal_ramp.rs`, at 50 Hz): coarse resolution and uneven heating are flagged
+/// as warnings, the ramp stays possible (its binning handles both), and no motion is
+/// seen on the static sensor whose bias drifts with temperature.
+#[test]
+fn simulated_quantised_uneven_ramp_is_flagged_and_fit() {
+    use driftless::sim::presets::Preset;
+    use driftless::sim::sensor::{IdealImu, OutputKind, SensorModel};
+    use driftless::sim::temperature::TemperatureProfile;
+    let mut cfg = Preset::Consumer.config();
+    cfg.temperature_sensor.lsb_c = 1.0;
+    cfg.valid_range_c = [-40.0, 85.0];
+    let model = SensorModel::new(cfg).expect("model");
+    let curve = TemperatureProfile::Series {
+        time_s: vec![0.0, 150.0, 600.0, 1800.0, 2000.0, 2500.0, 3600.0],
+        t_c: vec![20.0, 30.0, 50.0, 60.0, 55.0, 35.0, 20.0],
+    }
+    .curve()
+    .expect("curve");
+    let n = (3600.0 * RATE_HZ) as usize;
+    let ideal = IdealImu::constant(
+        OutputKind::Rates,
+        0.0,
+        1.0 / RATE_HZ,
+        n,
+        [1e-5, 2e-5, -6e-5],
+        [0.0, 0.0, -9.80],
+    );
+    let out = model.simulate(&ideal, &curve, 77).expect("simulate");
+    let time: Vec<f64> = (0..n).map(|k| out.time_s(k)).collect();
+    let mut channels = Vec::new();
+    for (k, name) in ["gyro_x", "gyro_y", "gyro_z"].iter().enumerate() {
+        channels.push(channel(name, Quantity::AngularRate, out.gyro[k].clone()));
+    }
+    for (k, name) in ["acc_x", "acc_y", "acc_z"].iter().enumerate() {
+        channels.push(channel(name, Quantity::SpecificForce, out.accel[k].clone()));
+    }
+    channels.push(channel(
+        "temperature",
+        Quantity::Temperature,
+        out.temperature_c.clone(),
+    ));
+    let c = check(&ImuLog::new("sim", Some(time), 1.0 / RATE_HZ, channels));
+    assert!(c.finding(FindingKind::CoarseResolution).is_some());
+    assert!(c.finding(FindingKind::UnevenHeating).is_some());
+    assert!(c.finding(FindingKind::Motion).is_none());
+    let h = c.heating.as_ref().unwrap();
+    assert!(h.heating_fraction > 0.3 && h.cooling_fraction > 0.3, "{h:?}");
+    assert!(c.fit_for_ramp, "{:?}", c.findings);
+}

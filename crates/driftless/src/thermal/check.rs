@@ -11,12 +11,15 @@
 //!   readings), and the number of 1 °C-wide levels holding at least
 //!   [`CheckOptions::min_samples_per_level`] samples — the bins the ramp fit uses.
 //! * **Heating-rate profile**: dT/dt by least squares over consecutive windows of
-//!   `w = max(rate_window_s, 5·LSB/|mean rate|)` (at least five LSB of change per window,
+//!   `w = max(rate_window_s, 5·LSB/(rise/duration))` (at least five LSB of change per window,
 //!   so a quantised reading still gives a slope); windows with |dT/dt| below
-//!   [`CheckOptions::flat_c_per_min`] are flat, the others heating or cooling. Unevenness
-//!   is the ratio of the 90th to the 10th percentile of |dT/dt| over the changing
-//!   windows. Runs of flat windows lasting [`CheckOptions::plateau_min_s`] are plateaus
-//!   (the set temperatures of a soak).
+//!   [`CheckOptions::flat_c_per_min`] are flat, the others heating or cooling.
+//!   **Unevenness** is the ratio of the 90th to the 10th percentile of the time spent per
+//!   1 °C level, per direction (heating samples and cooling samples apart; each
+//!   direction's first and last level, covered only in part, left out), the larger of
+//!   the two: the weight a per-sample fit would give each degree. Runs of flat windows
+//!   lasting [`CheckOptions::plateau_min_s`] are plateaus (the set temperatures of a
+//!   soak).
 //! * **Motion**: per window of [`CheckOptions::motion_window_s`], the mean gyro vector
 //!   against the median of its neighbours (±30 windows), and the tilt of the mean
 //!   specific force against the neighbours' median and against the whole log's median
@@ -62,7 +65,8 @@ pub struct CheckOptions {
     pub rate_window_s: f64,
     /// |dT/dt| below this is flat, °C/min (default 0.05).
     pub flat_c_per_min: f64,
-    /// Unevenness (p90/p10 of |dT/dt|) above this is flagged (default 5).
+    /// Unevenness (p90/p10 of the time per 1 °C level, module docs) above this is
+    /// flagged (default 5).
     pub uneven_ratio: f64,
     /// Shortest plateau, s (default 120).
     pub plateau_min_s: f64,
@@ -219,8 +223,11 @@ pub struct HeatingProfile {
     pub rate_p90_c_per_min: f64,
     /// Fastest window, °C/min (signed).
     pub rate_max_c_per_min: f64,
-    /// p90/p10 (1 when fewer than two changing windows).
+    /// p90/p10 of the time per 1 °C level, the larger of heating and cooling (module
+    /// docs); 1 when no direction has three inner levels.
     pub unevenness: f64,
+    /// 10th and 90th percentile of the time per 1 °C level in that direction, s.
+    pub dwell_p10_p90_s: [f64; 2],
     /// Plateaus.
     pub plateaus: Vec<Plateau>,
 }
@@ -513,15 +520,17 @@ pub fn check_log(log: &ImuLog, label: &str, opts: &CheckOptions) -> ThermalCheck
             soak: Impact::None,
             span: None,
             message: format!(
-                "{label}: uneven heating: |dT/dt| from {:.3} to {:.3} °C/min (10th–90th \
-                 percentile over {:.0}-s windows, ratio {:.1} > {:.1}); the ramp fit takes one \
-                 point per degree so slow stretches do not dominate, but the sensor's \
-                 thermal lag differs along the ramp — heat at a steady rate if you can",
+                "{label}: uneven heating: {:.0} to {:.0} s per degree (10th–90th percentile, \
+                 ratio {:.1} > {:.1}; |dT/dt| {:.3}–{:.3} °C/min over {:.0}-s windows); the ramp \
+                 fit takes one point per degree so slow stretches do not dominate, but the \
+                 sensor's thermal lag differs along the ramp — heat at a steady rate if you can",
+                heating.dwell_p10_p90_s[0],
+                heating.dwell_p10_p90_s[1],
+                heating.unevenness,
+                opts.uneven_ratio,
                 heating.rate_p10_c_per_min,
                 heating.rate_p90_c_per_min,
-                heating.window_s,
-                heating.unevenness,
-                opts.uneven_ratio
+                heating.window_s
             ),
         });
     }
@@ -535,7 +544,7 @@ pub fn check_log(log: &ImuLog, label: &str, opts: &CheckOptions) -> ThermalCheck
             soak: Impact::None,
             span: m.moving_spans.first().copied(),
             message: format!(
-                "{label}: the sensor moved in {:.1} % of {:.0}-s windows (gyro change up to \
+                "{label}: the sensor moved in {:.2} % of {:.0}-s windows (gyro change up to \
                  {:.3} rad/s, tilt up to {:.1}°), first at {}: a ramp needs the board \
                  untouched in one orientation{}",
                 100.0 * m.moving_fraction,
@@ -843,7 +852,7 @@ fn heating_profile(
     opts: &CheckOptions,
 ) -> HeatingProfile {
     let duration = time[time.len() - 1] - time[0];
-    let mean_rate = ((ts.end_c - ts.start_c) / duration.max(f64::MIN_POSITIVE)).abs();
+    let mean_rate = ts.rise_c / duration.max(f64::MIN_POSITIVE);
     let mut w = opts.rate_window_s;
     if ts.lsb_c > 0.0 && mean_rate > 0.0 {
         w = w.max(5.0 * ts.lsb_c / mean_rate);
@@ -869,11 +878,36 @@ fn heating_profile(
         quantile(&changing, 0.5),
         quantile(&changing, 0.9),
     );
-    let unevenness = if changing.len() >= 2 && p10 > 0.0 {
-        p90 / p10
-    } else {
-        1.0
-    };
+    // Time per 1 °C level, per direction (module docs).
+    let mut dwell = [
+        std::collections::BTreeMap::<i64, usize>::new(),
+        std::collections::BTreeMap::<i64, usize>::new(),
+    ];
+    for (win, r) in wins.iter().zip(&rates) {
+        if r.abs() < flat_lim {
+            continue;
+        }
+        let d = &mut dwell[usize::from(*r < 0.0)];
+        for i in win.clone() {
+            *d.entry(tc[i].round() as i64).or_default() += 1;
+        }
+    }
+    let dt = duration / (time.len() - 1).max(1) as f64;
+    let (mut unevenness, mut dwell_p10_p90_s) = (1.0, [0.0, 0.0]);
+    for d in &dwell {
+        if d.len() < 5 {
+            continue;
+        }
+        let mut v: Vec<f64> = d.values().map(|&c| c as f64 * dt).collect();
+        v.remove(v.len() - 1);
+        v.remove(0);
+        v.sort_by(f64::total_cmp);
+        let (a, b) = (quantile(&v, 0.1), quantile(&v, 0.9));
+        if a > 0.0 && b / a > unevenness {
+            unevenness = b / a;
+            dwell_p10_p90_s = [a, b];
+        }
+    }
     let rate_max = rates
         .iter()
         .copied()
@@ -931,6 +965,7 @@ fn heating_profile(
         rate_p90_c_per_min: p90,
         rate_max_c_per_min: rate_max,
         unevenness,
+        dwell_p10_p90_s,
         plateaus,
     }
 }
