@@ -357,7 +357,7 @@ fn soak_precheck(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), s| {
             (a.min(s.0), b.max(s.0))
         });
-    if !(hi - lo >= min_rise_c) {
+    if !(hi - lo).is_finite() || hi - lo < min_rise_c {
         anyhow::bail!(
             "{}: set temperatures span {lo}–{hi} °C ({:.1} °C); a thermal model needs at \
              least {min_rise_c} °C (add set points, or lower --min-rise)",

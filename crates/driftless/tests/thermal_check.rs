@@ -52,6 +52,11 @@ fn log(
             read
         });
     }
+    imu_log(time, ch)
+}
+
+/// A log of gyro x, y, z, accelerometer x, y, z and temperature columns (SI, °C).
+fn imu_log(time: Vec<f64>, ch: Vec<Vec<f64>>) -> ImuLog {
     let names = [
         "gyro_x",
         "gyro_y",
@@ -61,19 +66,17 @@ fn log(
         "acc_z",
         "temperature",
     ];
-    let qs = [
-        Quantity::AngularRate,
-        Quantity::AngularRate,
-        Quantity::AngularRate,
-        Quantity::SpecificForce,
-        Quantity::SpecificForce,
-        Quantity::SpecificForce,
-        Quantity::Temperature,
-    ];
     let channels = ch
         .into_iter()
-        .zip(names.iter().zip(qs))
-        .map(|(v, (n, q))| channel(n, q, v))
+        .enumerate()
+        .map(|(i, v)| {
+            let q = match i {
+                0..=2 => Quantity::AngularRate,
+                3..=5 => Quantity::SpecificForce,
+                _ => Quantity::Temperature,
+            };
+            channel(names[i], q, v)
+        })
         .collect();
     ImuLog::new("synthetic", Some(time), 1.0 / RATE_HZ, channels)
 }
@@ -283,28 +286,7 @@ fn six_positions_on_plateaus_are_fit_for_soak_not_ramp() {
         }
         ch[6].push(temp(t));
     }
-    let names = [
-        "gyro_x",
-        "gyro_y",
-        "gyro_z",
-        "acc_x",
-        "acc_y",
-        "acc_z",
-        "temperature",
-    ];
-    let channels = ch
-        .into_iter()
-        .enumerate()
-        .map(|(i, v)| {
-            let q = match i {
-                0..=2 => Quantity::AngularRate,
-                3..=5 => Quantity::SpecificForce,
-                _ => Quantity::Temperature,
-            };
-            channel(names[i], q, v)
-        })
-        .collect();
-    let l = ImuLog::new("soak", Some(time), 1.0 / RATE_HZ, channels);
+    let l = imu_log(time, ch);
     let c = check(&l);
     let h = c.heating.as_ref().unwrap();
     assert_eq!(h.plateaus.len(), 6, "{:?}", h.plateaus);
@@ -379,23 +361,16 @@ fn simulated_quantised_uneven_ramp_is_flagged_and_fit() {
     );
     let out = model.simulate(&ideal, &curve, 77).expect("simulate");
     let time: Vec<f64> = (0..n).map(|k| out.time_s(k)).collect();
-    let mut channels = Vec::new();
-    for (k, name) in ["gyro_x", "gyro_y", "gyro_z"].iter().enumerate() {
-        channels.push(channel(name, Quantity::AngularRate, out.gyro[k].clone()));
-    }
-    for (k, name) in ["acc_x", "acc_y", "acc_z"].iter().enumerate() {
-        channels.push(channel(name, Quantity::SpecificForce, out.accel[k].clone()));
-    }
-    channels.push(channel(
-        "temperature",
-        Quantity::Temperature,
-        out.temperature_c.clone(),
-    ));
-    let c = check(&ImuLog::new("sim", Some(time), 1.0 / RATE_HZ, channels));
+    let mut ch: Vec<Vec<f64>> = out.gyro.iter().chain(&out.accel).cloned().collect();
+    ch.push(out.temperature_c.clone());
+    let c = check(&imu_log(time, ch));
     assert!(c.finding(FindingKind::CoarseResolution).is_some());
     assert!(c.finding(FindingKind::UnevenHeating).is_some());
     assert!(c.finding(FindingKind::Motion).is_none());
     let h = c.heating.as_ref().unwrap();
-    assert!(h.heating_fraction > 0.3 && h.cooling_fraction > 0.3, "{h:?}");
+    assert!(
+        h.heating_fraction > 0.3 && h.cooling_fraction > 0.3,
+        "{h:?}"
+    );
     assert!(c.fit_for_ramp, "{:?}", c.findings);
 }

@@ -389,6 +389,16 @@ fn distinct_groups(t_c: &[f64]) -> Vec<Vec<usize>> {
     groups
 }
 
+/// `keep` ← the indices of every group but group `g`.
+fn all_but(groups: &[Vec<usize>], g: usize, keep: &mut Vec<usize>) {
+    keep.clear();
+    for (h, other) in groups.iter().enumerate() {
+        if h != g {
+            keep.extend_from_slice(other);
+        }
+    }
+}
+
 /// Weighted least squares on u = (T − T_c)/h over the points `idx` by Householder QR
 /// (Golub & Van Loan §5.1.2 Householder vectors, §5.3.3 LS via QR).
 fn solve_scaled(
@@ -739,12 +749,7 @@ pub fn cross_validate(
     let mut residuals = vec![0.0; n];
     let mut keep = Vec::with_capacity(n);
     for (g, group) in groups.iter().enumerate() {
-        keep.clear();
-        for (h, other) in groups.iter().enumerate() {
-            if h != g {
-                keep.extend_from_slice(other);
-            }
-        }
+        all_but(&groups, g, &mut keep);
         let core = solve_scaled(t_c, y, sigma, &keep, order + 1)?;
         for &i in group {
             residuals[i] = y[i] - horner_scaled(&core.a, core.t_centre, core.half_range, t_c[i]);
@@ -855,12 +860,7 @@ pub fn held_out(
     };
     let mut keep = Vec::with_capacity(n);
     for (g, group) in groups.iter().enumerate() {
-        keep.clear();
-        for (h, other) in groups.iter().enumerate() {
-            if h != g {
-                keep.extend_from_slice(other);
-            }
-        }
+        all_but(&groups, g, &mut keep);
         let nk = keep.len();
         let ck: Vec<f64> = (0..nk * nk)
             .map(|q| cfull[keep[q / nk] * n + keep[q % nk]])
