@@ -776,6 +776,8 @@ fn export(e: ExportArgs) -> Result<()> {
                 "check_temperatures_c": temps,
                 "files": files,
                 "dropped_scale_delta_max": {"accel": ds(&bm.accel), "gyro": ds(&bm.gyro)},
+                // PX4 and ArduPilot have no gyro g-sensitivity parameter
+                "dropped_gyro_g_sensitivity": file.gyro_g_sensitivity.is_some(),
             }))?
         );
     } else {
@@ -796,6 +798,12 @@ fn export(e: ExportArgs) -> Result<()> {
             crate::output::sci(ds(&bm.accel)),
             crate::output::sci(ds(&bm.gyro))
         );
+        if file.gyro_g_sensitivity.is_some() {
+            println!(
+                "the model's gyro g-sensitivity is not exported: neither autopilot has a \
+                 parameter for it"
+            );
+        }
     }
     if worst > 1e-6 {
         anyhow::bail!(

@@ -34,7 +34,7 @@ fn log(
     let n = (duration_s * RATE_HZ) as usize;
     let mut rng = Rng::seed_from_u64(seed);
     let time: Vec<f64> = (0..n).map(|k| k as f64 / RATE_HZ).collect();
-    let mut ch: Vec<Vec<f64>> = vec![Vec::with_capacity(n); 7];
+    let mut ch: Vec<Vec<f64>> = (0..7).map(|_| Vec::with_capacity(n)).collect();
     for &t in &time {
         let tc = temp(t);
         let (w, tilt) = motion(t);
@@ -272,7 +272,7 @@ fn six_positions_on_plateaus_are_fit_for_soak_not_ramp() {
         [0.0, -1.0, 0.0],
     ];
     let time: Vec<f64> = (0..n).map(|k| k as f64 / RATE_HZ).collect();
-    let mut ch: Vec<Vec<f64>> = vec![Vec::with_capacity(n); 7];
+    let mut ch: Vec<Vec<f64>> = (0..7).map(|_| Vec::with_capacity(n)).collect();
     for &t in &time {
         let u = t - (t / step).floor() * step;
         let f = if u < hold {
