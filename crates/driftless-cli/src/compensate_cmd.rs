@@ -3,7 +3,8 @@
 //! sample at the log's own temperature reading) and writes the compensated log (CSV, or
 //! DRIFTLOG for `.dlog`). The output names the model in its source line
 //! (`compensated by driftless thermal model 0x…`); an input that already carries such a
-//! stamp is refused, so a model is never applied twice.
+//! stamp is refused, so a model is never applied twice. Samples whose temperature lies
+//! outside the model's calibrated range are reported on stderr with their time spans.
 
 use anyhow::{Result, bail};
 use clap::Args;
@@ -46,6 +47,49 @@ fn existing_stamp(path: &Path, log: &ImuLog) -> Option<String> {
     [first.unwrap_or_default(), log.source.clone()]
         .into_iter()
         .find_map(|s| s.find(STAMP).map(|i| s[i..].trim().to_string()))
+}
+
+/// Warns on stderr, with the time spans, where the log's temperature leaves the model's
+/// calibrated range (the model then clamps, extrapolates or refuses, per `policy`):
+/// compensation outside the range is never silent.
+pub fn warn_out_of_range(
+    path: &Path,
+    log: &ImuLog,
+    temperature_c: &[f64],
+    range_c: &[f64; 2],
+    policy: &str,
+) -> usize {
+    let spans = driftless::thermal::check::out_of_range_spans(
+        log.time_s.as_deref(),
+        log.tau0_s,
+        temperature_c,
+        *range_c,
+    );
+    if spans.is_empty() {
+        return 0;
+    }
+    let samples: usize = spans.iter().map(|e| e.samples).sum();
+    let what = match policy {
+        "clamp" => "the model holds its end values there (clamp)",
+        "extrapolate" => "the model extrapolates its polynomials there",
+        _ => "the model refuses such samples",
+    };
+    eprintln!(
+        "warning: {}: {samples} of {} samples in {} span(s) lie outside the model's \
+         calibrated range [{}, {}] °C; {what} — calibrate over a wider range for this use:",
+        path.display(),
+        temperature_c.len(),
+        spans.len(),
+        range_c[0],
+        range_c[1]
+    );
+    for e in spans.iter().take(10) {
+        eprintln!("  {}", e.describe());
+    }
+    if spans.len() > 10 {
+        eprintln!("  … and {} more span(s)", spans.len() - 10);
+    }
+    samples
 }
 
 pub fn run(a: CompensateArgs) -> Result<()> {
@@ -102,6 +146,7 @@ pub fn run(a: CompensateArgs) -> Result<()> {
         .map(|i| std::array::from_fn(|k| log.channels[ai[k]].values[i]))
         .collect();
     let temp = &log.channels[ti].values;
+    warn_out_of_range(&a.log, &log, temp, &file.range_c, &file.out_of_range);
     let t0 = std::time::Instant::now();
     model
         .compensate_block(&mut gyro, &mut accel, temp)
@@ -134,11 +179,16 @@ pub fn run(a: CompensateArgs) -> Result<()> {
             (a.min(t), b.max(t))
         });
     println!(
-        "{}: {n} samples at {lo:.2}–{hi:.2} °C compensated with model {:#x} (valid {:?} °C, {}) in {:.3} s → {}",
+        "{}: {n} samples at {lo:.2}–{hi:.2} °C compensated with model {:#x} (valid {:?} °C, {}{}) in {:.3} s → {}",
         a.log.display(),
         model.id(),
         file.range_c,
         file.out_of_range,
+        if model.gyro_g_sensitivity().is_some() {
+            ", gyro g-sensitivity"
+        } else {
+            ""
+        },
         secs,
         a.out.display()
     );

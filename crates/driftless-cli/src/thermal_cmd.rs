@@ -10,9 +10,11 @@
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use driftless::calib::six_position::SixPositionOptions;
+use driftless::io::ImuLog;
 use driftless::io::Quantity;
 use driftless::sim::chamber_manifest::ChamberManifest;
 use driftless::thermal::FitOptions;
+use driftless::thermal::check::{CheckOptions, FindingKind, Impact, ThermalCheck, check_log};
 use driftless::thermal::model_file::ThermalModelFile;
 use driftless::thermal::soak::soak_calibration;
 use driftless_model::compensation::OutOfRange;
@@ -34,6 +36,27 @@ pub enum ThermalMethod {
     Ramp(RampArgs),
     /// A model's bias part as PX4 TC_* and/or ArduPilot INS_TCAL* parameter files.
     Export(ExportArgs),
+    /// Can this log give a thermal model? Temperature range, rise and resolution,
+    /// heating-rate profile, motion and gaps, with a verdict per IMU instance.
+    Check(CheckArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct CheckArgs {
+    /// Log: CSV/text or DRIFTLOG (one IMU), PX4 ULog or ArduPilot DataFlash (every IMU
+    /// instance is checked).
+    pub log: PathBuf,
+    /// Polynomial order the model will have (sets how many levels/plateaus are needed).
+    #[arg(long, default_value_t = 3)]
+    pub order: usize,
+    /// Smallest temperature rise a model needs, °C.
+    #[arg(long, default_value_t = 10.0)]
+    pub min_rise: f64,
+    /// Machine-readable output.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub input: InputArgs,
 }
 
 #[derive(Args, Debug)]
@@ -79,6 +102,10 @@ pub struct RampArgs {
     /// Temperature bin width, °C.
     #[arg(long, default_value_t = 1.0)]
     pub bin: f64,
+    /// Smallest temperature rise the log must show, °C (the checks of `thermal check`
+    /// run first and refuse a log that cannot give a model).
+    #[arg(long, default_value_t = 10.0)]
+    pub min_rise: f64,
     /// Write a bias-only compensation model file here (TOML): matrix I, no scale terms,
     /// gyro bias = fit at T_ref, accelerometer bias 0 (not separable from gravity).
     #[arg(long, value_name = "FILE.toml")]
@@ -110,6 +137,9 @@ pub struct SoakArgs {
     /// it (without it they describe only the scatter within each step).
     #[arg(long, value_name = "FILE.toml")]
     pub noise_model: Option<PathBuf>,
+    /// Smallest span of the set temperatures, °C.
+    #[arg(long, default_value_t = 10.0)]
+    pub min_rise: f64,
     /// Outside the soaked range: clamp, extrapolate or error.
     #[arg(long, default_value = "clamp")]
     pub out_of_range: String,
@@ -131,7 +161,224 @@ pub fn run(a: ThermalArgs) -> Result<()> {
         ThermalMethod::Soak(s) => soak(s),
         ThermalMethod::Ramp(r) => ramp(r),
         ThermalMethod::Export(e) => export(e),
+        ThermalMethod::Check(c) => check(c),
     }
+}
+
+/// What the "scatter/σ" column means.
+const SCATTER_NOTE: &str = "scatter/σ: √(χ²/dof) of the points against their own σ; where \
+     above 1 the σ and bands are scaled by it (×), so they match the scatter seen";
+
+/// "1.23 ×" when the σ were scaled by the scatter, "0.87" when not, "–" without σ.
+fn scatter_cell(f: &driftless::thermal::ThermalFit) -> String {
+    match f.scatter_ratio {
+        Some(r) if f.noise_scale == driftless::thermal::NoiseScale::Inflated => {
+            format!("{r:.2} ×")
+        }
+        Some(r) => format!("{r:.2}"),
+        None => "–".into(),
+    }
+}
+
+/// Every IMU instance of `path` with its label: all instances of an autopilot log, or
+/// the one log of a text / DRIFTLOG file. Gaps are bridged (and reported by the check)
+/// unless `--gaps` asks otherwise.
+fn read_instances(path: &std::path::Path, input: &InputArgs) -> Result<Vec<(String, ImuLog)>> {
+    #[cfg(feature = "autopilot-logs")]
+    {
+        use std::io::Read;
+        let mut head = Vec::with_capacity(8);
+        std::fs::File::open(path)
+            .and_then(|f| f.take(8).read_to_end(&mut head))
+            .with_context(|| format!("reading {}", path.display()))?;
+        if driftless::io::detect_format(&head).is_some()
+            && let Some(all) = driftless::io::imu_logs_from_autopilot_file(path)?
+        {
+            if all.imus.is_empty() {
+                anyhow::bail!(
+                    "{}: {} log without IMU data (found: {}); nothing to check",
+                    path.display(),
+                    all.format.name(),
+                    all.found
+                        .iter()
+                        .map(|(n, c)| format!("{n} ×{c}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+            }
+            if let Some(at) = all.truncated_at_byte {
+                eprintln!(
+                    "{}: truncated; read up to the message cut off at byte {at}",
+                    path.display()
+                );
+            }
+            return Ok(all
+                .imus
+                .into_iter()
+                .map(|i| (format!("{} instance {}", path.display(), i.instance), i.log))
+                .collect());
+        }
+    }
+    let mut input = input.clone();
+    input.time_column.get_or_insert_with(|| "1".into());
+    if input.gaps == "error" {
+        input.gaps = "bridge".into();
+    }
+    let log = input.read(path)?;
+    Ok(vec![(path.display().to_string(), log)])
+}
+
+/// Check options for a fit of `order`.
+fn check_options(order: usize, min_rise_c: f64) -> Result<CheckOptions> {
+    if !(min_rise_c.is_finite() && min_rise_c >= 0.0) {
+        anyhow::bail!("--min-rise {min_rise_c}: give a temperature rise in °C, ≥ 0");
+    }
+    Ok(CheckOptions {
+        order,
+        min_rise_c,
+        ..CheckOptions::default()
+    })
+}
+
+fn check(c: CheckArgs) -> Result<()> {
+    let opts = check_options(c.order, c.min_rise)?;
+    let reports: Vec<ThermalCheck> = read_instances(&c.log, &c.input)?
+        .iter()
+        .map(|(label, log)| check_log(log, label, &opts))
+        .collect();
+    if c.json {
+        println!("{}", serde_json::to_string_pretty(&reports)?);
+        return Ok(());
+    }
+    let mut tab = crate::output::Table::new(
+        [
+            "instance",
+            "samples",
+            "span (s)",
+            "T (°C)",
+            "rise (°C)",
+            "LSB (°C)",
+            "dT/dt p10/50/90 (°C/min)",
+            "moving",
+            "gaps",
+            "verdict",
+        ]
+        .map(String::from)
+        .to_vec(),
+    );
+    for r in &reports {
+        let t = r.temperature.as_ref();
+        let h = r.heating.as_ref();
+        tab.row(vec![
+            r.label.clone(),
+            r.samples.to_string(),
+            r.span
+                .map_or("–".into(), |s| format!("{:.1}", s.end_s - s.start_s)),
+            t.map_or("–".into(), |t| format!("{:.2}–{:.2}", t.min_c, t.max_c)),
+            t.map_or("–".into(), |t| format!("{:.2}", t.rise_c)),
+            t.map_or("–".into(), |t| format!("{:.3}", t.lsb_c)),
+            h.map_or("–".into(), |h| {
+                format!(
+                    "{:.2}/{:.2}/{:.2}",
+                    h.rate_p10_c_per_min, h.rate_median_c_per_min, h.rate_p90_c_per_min
+                )
+            }),
+            r.motion.as_ref().map_or("–".into(), |m| {
+                format!("{:.1} %", 100.0 * m.moving_fraction)
+            }),
+            format!("{} ({:.1} s)", r.gaps.count, r.gaps.total_s),
+            r.verdict().to_string(),
+        ]);
+    }
+    print!("{}", tab.render());
+    for r in &reports {
+        println!("{}: fit for {}", r.label, r.verdict());
+        for f in &r.findings {
+            let tag = |i: Impact| match i {
+                Impact::Block => "refused",
+                Impact::Warn => "warning",
+                Impact::None => "–",
+            };
+            println!(
+                "  [ramp {}, soak {}] {}",
+                tag(f.ramp),
+                tag(f.soak),
+                f.message
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The checks `thermal ramp` runs first: refuses (with every blocking finding) a log the
+/// ramp method cannot give a model from, prints the warnings on stderr.
+fn ramp_precheck(
+    log: &ImuLog,
+    path: &std::path::Path,
+    order: usize,
+    min_rise_c: f64,
+) -> Result<()> {
+    let opts = check_options(order, min_rise_c)?;
+    let r = check_log(log, &path.display().to_string(), &opts);
+    for f in r.findings.iter().filter(|f| f.ramp == Impact::Warn) {
+        eprintln!("warning: {}", f.message);
+    }
+    let blocking = r.blocking(true);
+    if !blocking.is_empty() {
+        anyhow::bail!(
+            "the ramp method cannot give a model from this log:\n  {}\n(`driftless thermal \
+             check` prints the full report; --min-rise lowers the rise required)",
+            blocking
+                .iter()
+                .map(|f| f.message.as_str())
+                .collect::<Vec<_>>()
+                .join("\n  ")
+        );
+    }
+    Ok(())
+}
+
+/// The checks `thermal soak` runs first: the set temperatures of the manifest must span
+/// `min_rise_c`; the log's temperature, when it has one, must be finite; gaps are
+/// warned about. The positions come from the manifest, so plateau and orientation
+/// findings of the log alone do not apply.
+fn soak_precheck(
+    log: &ImuLog,
+    path: &std::path::Path,
+    manifest: &ChamberManifest,
+    manifest_path: &std::path::Path,
+    order: usize,
+    min_rise_c: f64,
+) -> Result<()> {
+    let opts = check_options(order, min_rise_c)?;
+    let steps = manifest.steps();
+    let (lo, hi) = steps
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), s| {
+            (a.min(s.0), b.max(s.0))
+        });
+    if !(hi - lo).is_finite() || hi - lo < min_rise_c {
+        anyhow::bail!(
+            "{}: set temperatures span {lo}–{hi} °C ({:.1} °C); a thermal model needs at \
+             least {min_rise_c} °C (add set points, or lower --min-rise)",
+            manifest_path.display(),
+            hi - lo
+        );
+    }
+    if log.indices_of(Quantity::Temperature).is_empty() {
+        return Ok(());
+    }
+    let r = check_log(log, &path.display().to_string(), &opts);
+    for f in &r.findings {
+        match f.kind {
+            FindingKind::NoData | FindingKind::BadTemperature => anyhow::bail!("{}", f.message),
+            FindingKind::Gaps | FindingKind::CoarseResolution => {
+                eprintln!("warning: {}", f.message)
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 fn soak(s: SoakArgs) -> Result<()> {
@@ -159,6 +406,7 @@ fn soak(s: SoakArgs) -> Result<()> {
     };
     let gyro = pick(Quantity::AngularRate, "angular-rate")?;
     let accel = pick(Quantity::SpecificForce, "specific-force")?;
+    soak_precheck(&log, &s.log, &manifest, &s.manifest, s.order, s.min_rise)?;
     let fit_opts = FitOptions {
         order: s.order,
         t_ref_c: s.t_ref,
@@ -226,6 +474,9 @@ fn soak(s: SoakArgs) -> Result<()> {
                     "triad": x.triad, "quantity": x.quantity, "axis": (["x", "y", "z"][x.axis]),
                     "coefficients": x.fit.coeffs, "std_errors": x.fit.std_errors,
                     "residual_rms": x.fit.residual_rms, "chi2_per_dof": x.fit.chi2_per_dof,
+                    // √(χ²/dof) of the points against their σ, and the factor applied
+                    // to the σ (≥ 1: the bands follow the scatter seen)
+                    "scatter_ratio": x.fit.scatter_ratio, "sigma_scale": x.fit.sigma_scale,
                 })
             })
             .collect();
@@ -257,6 +508,7 @@ fn soak(s: SoakArgs) -> Result<()> {
     let mut head = vec!["series".to_string()];
     head.extend((0..=s.order).map(|k| format!("c{k} ± σ")));
     head.push("resid. RMS".into());
+    head.push("scatter/σ".into());
     let mut tab = crate::output::Table::new(head);
     for x in &soak.series {
         let mut row = vec![format!(
@@ -273,11 +525,13 @@ fn soak(s: SoakArgs) -> Result<()> {
             ));
         }
         row.push(crate::output::sci(x.fit.residual_rms));
+        row.push(scatter_cell(&x.fit));
         tab.row(row);
     }
     print!("{}", tab.render());
+    println!("{SCATTER_NOTE}");
     if let Some(g) = &g_mean {
-        // Estimated per step (rate segments all +k up); not part of the model file.
+        // Estimated per step (rate segments all +k up); the model file carries the mean.
         let d = |i: usize| {
             format!(
                 "{} ± {}",
@@ -307,6 +561,7 @@ fn ramp(r: RampArgs) -> Result<()> {
     let Some(time) = log.time_s.as_deref() else {
         anyhow::bail!("{}: no time column", r.log.display());
     };
+    ramp_precheck(&log, &r.log, r.order, r.min_rise)?;
     let Some(temp) = log
         .channels
         .iter()
@@ -397,6 +652,7 @@ fn ramp(r: RampArgs) -> Result<()> {
                 serde_json::json!({
                     "channel": n, "coefficients": f.coeffs, "std_errors": f.std_errors,
                     "residual_rms": f.residual_rms,
+                    "scatter_ratio": f.scatter_ratio, "sigma_scale": f.sigma_scale,
                     "hysteresis_rms": res.hysteresis.as_ref().map(|h| h[k]),
                 })
             })
@@ -424,6 +680,7 @@ fn ramp(r: RampArgs) -> Result<()> {
     let mut head = vec!["channel".to_string()];
     head.extend((0..=r.order).map(|k| format!("c{k} ± σ")));
     head.push("hysteresis RMS".into());
+    head.push("scatter/σ".into());
     let mut tab = crate::output::Table::new(head);
     for (k, (n, f)) in res.names.iter().zip(&res.fits).enumerate() {
         let mut row = vec![n.clone()];
@@ -439,9 +696,11 @@ fn ramp(r: RampArgs) -> Result<()> {
                 .as_ref()
                 .map_or("–".into(), |h| crate::output::sci(h[k])),
         );
+        row.push(scatter_cell(f));
         tab.row(row);
     }
     print!("{}", tab.render());
+    println!("{SCATTER_NOTE}");
     if let Some(p) = &r.out {
         println!("wrote {} (bias-only model)", p.display());
     }
@@ -517,6 +776,8 @@ fn export(e: ExportArgs) -> Result<()> {
                 "check_temperatures_c": temps,
                 "files": files,
                 "dropped_scale_delta_max": {"accel": ds(&bm.accel), "gyro": ds(&bm.gyro)},
+                // PX4 and ArduPilot have no gyro g-sensitivity parameter
+                "dropped_gyro_g_sensitivity": file.gyro_g_sensitivity.is_some(),
             }))?
         );
     } else {
@@ -537,6 +798,12 @@ fn export(e: ExportArgs) -> Result<()> {
             crate::output::sci(ds(&bm.accel)),
             crate::output::sci(ds(&bm.gyro))
         );
+        if file.gyro_g_sensitivity.is_some() {
+            println!(
+                "the model's gyro g-sensitivity is not exported: neither autopilot has a \
+                 parameter for it"
+            );
+        }
     }
     if worst > 1e-6 {
         anyhow::bail!(

@@ -324,12 +324,173 @@ fn ramp_on_a_simulated_warm_up() {
         .arg(dir.join("sim/imu.csv"))
         .output()
         .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    // The model's range ends at the last bin centre (49 °C); the log goes on warming to
+    // ~49.5 °C: those samples are named with their time span, not compensated silently.
+    let range: Vec<f64> = toml::from_str::<toml::Value>(&model).unwrap()["range_c"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_float().unwrap())
+        .collect();
+    eprintln!("{err}");
+    assert!(
+        err.contains("outside the model's calibrated range")
+            && err.contains(&format!("[{}, {}] °C", range[0], range[1]))
+            && err.contains("hold")
+            && err.contains("t = "),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `thermal check` on simulated static warm-ups (CSV): a 20 → 50 °C warm-up is fit for the
+/// ramp method and flagged as uneven (exponential warm-up); a 25 → 31 °C one is fit for
+/// neither, and `thermal ramp` refuses it naming the file, the rise and what to change.
+#[test]
+fn check_verdicts_and_ramp_refusal_on_simulated_warm_ups() {
+    let dir = std::env::temp_dir().join(format!("driftless-check-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, t1) in [("wide", 50.0), ("narrow", 31.0)] {
+        simulate(
+            &dir,
+            name,
+            &format!(
+                "seed = 4\n[imu]\nrate_hz = 50.0\npreset = \"consumer\"\noutput = \"rates\"\n\
+                 [trajectory]\ntype = \"static\"\nlat_deg = 45.0\nduration_s = 1200.0\n\
+                 [temperature]\nkind = \"warm_up\"\nt0_c = {t0}\nt1_c = {t1}\ntau_s = 300.0\n",
+                t0 = if name == "wide" { 20.0 } else { 25.0 }
+            ),
+        );
+    }
+    let v = run_json(
+        bin()
+            .args(["thermal", "check", "--json"])
+            .arg(dir.join("wide/imu.csv")),
+    );
+    let r = &v.as_array().unwrap()[0];
+    assert_eq!(r["fit_for_ramp"], true, "{r}");
+    assert_eq!(r["fit_for_soak"], false, "{r}");
+    let kinds: Vec<&str> = r["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["kind"].as_str().unwrap())
+        .collect();
+    assert!(kinds.contains(&"uneven_heating"), "{kinds:?}");
+    assert!(
+        !kinds.contains(&"motion") && !kinds.contains(&"too_little_rise"),
+        "{kinds:?}"
+    );
+    let rise = r["temperature"]["rise_c"].as_f64().unwrap();
+    assert!((rise - 29.4).abs() < 0.6, "{rise}");
+    let v = run_json(
+        bin()
+            .args(["thermal", "check", "--json"])
+            .arg(dir.join("narrow/imu.csv")),
+    );
+    let r = &v.as_array().unwrap()[0];
+    assert_eq!(
+        (&r["fit_for_ramp"], &r["fit_for_soak"]),
+        (&false.into(), &false.into())
+    );
+    // The table names the verdict and why.
+    let out = bin()
+        .args(["thermal", "check"])
+        .arg(dir.join("narrow/imu.csv"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(
+        text.contains("fit for neither") && text.contains("[ramp refused, soak refused]"),
+        "{text}"
+    );
+    let out = bin()
+        .args(["thermal", "ramp"])
+        .arg(dir.join("narrow/imu.csv"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("narrow/imu.csv")
+            && err.contains("needs at least 10.0 °C")
+            && err.contains("--min-rise"),
+        "{err}"
+    );
+    // Lowering the bar is the user's call: the same log then fits.
+    let out = bin()
+        .args(["thermal", "ramp", "--min-rise", "5", "--order", "2"])
+        .arg(dir.join("narrow/imu.csv"))
+        .output()
+        .unwrap();
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    let out = bin()
+        .args(["thermal", "check", "--min-rise", "nan"])
+        .arg(dir.join("narrow/imu.csv"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--min-rise"));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `thermal check` on the real autopilot logs: pyulog's PX4 ULog (three IMU instances,
+/// about 28–40 °C, each nearly constant over its 6 samples) and the truncated ArduPilot
+/// DataFlash log (two instances, 10 samples): every instance fit for neither method,
+/// for too little rise, with its own temperatures.
+#[test]
+#[ignore = "needs shared data"]
+fn check_on_real_autopilot_logs() {
+    let v = run_json(
+        bin()
+            .args(["thermal", "check", "--json"])
+            .arg(data("logs/px4_ulog/sample_log_small.ulg")),
+    );
+    let r = v.as_array().unwrap();
+    assert_eq!(r.len(), 3);
+    let mut lows = Vec::new();
+    for (i, x) in r.iter().enumerate() {
+        assert!(
+            x["label"]
+                .as_str()
+                .unwrap()
+                .ends_with(&format!("instance {i}"))
+        );
+        assert_eq!(
+            (&x["fit_for_ramp"], &x["fit_for_soak"]),
+            (&false.into(), &false.into())
+        );
+        assert_eq!(x["findings"][0]["kind"], "too_little_rise", "{x}");
+        assert!(x["temperature"]["rise_c"].as_f64().unwrap() < 0.5);
+        lows.push(x["temperature"]["min_c"].as_f64().unwrap());
+    }
+    eprintln!("ULog instance temperatures (min): {lows:?}");
+    assert!(
+        (lows[0] - 40.03).abs() < 0.01 && (lows[1] - 28.25).abs() < 0.01,
+        "{lows:?}"
+    );
+    let v = run_json(
+        bin()
+            .args(["thermal", "check", "--json"])
+            .arg(data("logs/ardupilot_dataflash/backend_log_80k.bin")),
+    );
+    let r = v.as_array().unwrap();
+    assert_eq!(r.len(), 2);
+    for x in r {
+        assert_eq!(x["samples"], 10);
+        assert_eq!(
+            (&x["fit_for_ramp"], &x["fit_for_soak"]),
+            (&false.into(), &false.into())
+        );
+        assert_eq!(x["findings"][0]["kind"], "too_little_rise", "{x}");
+    }
 }
 
 /// `driftless thermal export` on the worked example of docs/autopilot-thermal.md: both
@@ -414,9 +575,9 @@ fn data(rel: &str) -> std::path::PathBuf {
 
 /// `thermal ramp` on pyulog's real PX4 ULog (`logs/px4_ulog/sample_log_small.ulg`): the
 /// log is recognised by its magic bytes, its three IMU instances are listed with their
-/// temperatures, and — 6 samples at 1 Hz spanning 0.34 °C — the ramp fails with the
-/// clear too-few-bins message rather than fitting noise. `--instance 7` names the
-/// instances that exist.
+/// temperatures, and — 6 samples at 1 Hz spanning 0.29 °C — the checks run first refuse
+/// it, naming the rise and the levels missing, rather than fitting noise. `--instance 7`
+/// names the instances that exist.
 #[test]
 #[ignore = "needs shared data"]
 fn ramp_on_a_real_px4_ulog_fails_clearly_for_lack_of_temperature_span() {
@@ -432,9 +593,18 @@ fn ramp_on_a_real_px4_ulog_fails_clearly_for_lack_of_temperature_span() {
     assert!(err.contains("sensor_gyro[2] ×6"), "{err}");
     assert!(err.contains("instance 2: 6 samples"), "{err}");
     assert!(err.contains("temperature 29.43–29.72 °C  ← used"), "{err}");
-    assert!(err.contains("span 0.29 °C"), "{err}");
     assert!(
-        err.contains("0 temperature bins with ≥ 50 samples; an order-3 fit needs at least 5"),
+        err.contains("the ramp method cannot give a model from this log"),
+        "{err}"
+    );
+    assert!(
+        err.contains("sample_log_small.ulg: temperature 29.43–29.72 °C, a rise of 0.29 °C; a thermal model needs at least 10.0 °C"),
+        "{err}"
+    );
+    assert!(
+        err.contains(
+            "0 one-degree level(s) with ≥ 50 samples; an order-3 ramp fit needs at least 5"
+        ),
         "{err}"
     );
     let out = bin()

@@ -50,6 +50,21 @@
 //! polynomials in ΔT = T − T_ref (Δs's coefficients are d_j/(1 + d₀), j ≥ 1), built by
 //! [`TriadThermal::from_forward`].
 //!
+//! ## Gyro g-sensitivity
+//!
+//! A MEMS gyro also responds to specific force: raw_ω = A·ω + b + G·f (G in raw gyro
+//! units per m/s²; Groves 2013 §4.4.4). A model may carry G
+//! ([`CompensationModel::with_gyro_g_sensitivity`], estimated by the soak's six-position
+//! fits); the gyro is then compensated with the compensated specific force of the same
+//! sample as the best estimate of f:
+//!
+//! ```text
+//! f_out = M_a(T)·(raw_a − b_a(T))
+//! ω_out = M_g(T)·(raw_ω − b_g(T) − G·f_out)
+//! ```
+//!
+//! Without G the gyro line is ω_out = M_g(T)·(raw_ω − b_g(T)), as before.
+//!
 //! # Temperature range
 //!
 //! The fitted range is [`CompensationModel::range_c`] (the polynomials' own ranges must
@@ -289,6 +304,21 @@ pub struct CompensationModel {
     range_c: [f64; 2],
     policy: OutOfRange,
     bank: DeltaBank,
+    /// G, raw gyro units per m/s², and its f32 copy.
+    g_sens: Option<(Mat3, [[f32; 3]; 3])>,
+}
+
+/// raw − G·f (f64).
+#[inline(always)]
+fn minus_g(raw: Vec3, g: &Mat3, f: Vec3) -> Vec3 {
+    let gf = g.mul_vec(f);
+    [raw[0] - gf[0], raw[1] - gf[1], raw[2] - gf[2]]
+}
+
+/// raw − G·f (f32).
+#[inline(always)]
+fn minus_g32(raw: [f32; 3], g: &[[f32; 3]; 3], f: [f32; 3]) -> [f32; 3] {
+    core::array::from_fn(|k| raw[k] - (g[k][0] * f[0] + g[k][1] * f[1] + g[k][2] * f[2]))
 }
 
 /// Effective f32 calibration of one triad at one temperature.
@@ -513,7 +543,55 @@ impl CompensationModel {
             range_c,
             policy,
             bank: DeltaBank::new(&gyro, &accel),
+            g_sens: None,
         })
+    }
+
+    /// The same model with the gyro g-sensitivity G (raw gyro units per m/s²: raw_ω =
+    /// A·ω + b + G·f) compensated too (module doc). Every entry must be finite.
+    pub fn with_gyro_g_sensitivity(
+        mut self,
+        g: Mat3,
+    ) -> Result<CompensationModel, CompensationError> {
+        if !g.0.iter().flatten().all(|v| v.is_finite()) {
+            return Err(CompensationError::InvalidModel(
+                "gyro g-sensitivity must be finite",
+            ));
+        }
+        self.g_sens = Some((g, g.0.map(|r| r.map(|v| v as f32))));
+        Ok(self)
+    }
+
+    /// The gyro g-sensitivity G compensated by this model, raw gyro units per m/s².
+    pub fn gyro_g_sensitivity(&self) -> Option<&Mat3> {
+        self.g_sens.as_ref().map(|g| &g.0)
+    }
+
+    /// Applies an effective calibration to one sample (with G when present).
+    #[inline(always)]
+    fn apply(&self, c: &ImuCalibration, gyro_raw: Vec3, accel_raw: Vec3) -> (Vec3, Vec3) {
+        let f = c.accel.apply(accel_raw);
+        let w = match &self.g_sens {
+            Some((g, _)) => c.gyro.apply(minus_g(gyro_raw, g, f)),
+            None => c.gyro.apply(gyro_raw),
+        };
+        (w, f)
+    }
+
+    /// [`Self::apply`] in f32.
+    #[inline(always)]
+    fn apply32(
+        &self,
+        c: &[Triad32; 2],
+        gyro_raw: [f32; 3],
+        accel_raw: [f32; 3],
+    ) -> ([f32; 3], [f32; 3]) {
+        let f = c[1].apply(accel_raw);
+        let w = match &self.g_sens {
+            Some((_, g)) => c[0].apply(minus_g32(gyro_raw, g, f)),
+            None => c[0].apply(gyro_raw),
+        };
+        (w, f)
     }
 
     /// The model id (recorded in a [`CompensationStamp`]).
@@ -609,7 +687,7 @@ impl CompensationModel {
         t_c: f64,
     ) -> Result<(Vec3, Vec3), CompensationError> {
         let c = self.calibration_at(t_c)?;
-        Ok((c.gyro.apply(gyro_raw), c.accel.apply(accel_raw)))
+        Ok(self.apply(&c, gyro_raw, accel_raw))
     }
 
     /// [`Self::compensate`] with f32 samples: factors in f64, rounded to f32, applied in
@@ -620,8 +698,8 @@ impl CompensationModel {
         accel_raw: [f32; 3],
         t_c: f32,
     ) -> Result<([f32; 3], [f32; 3]), CompensationError> {
-        let [g, a] = self.calibration_at_f32(t_c)?;
-        Ok((g.apply(gyro_raw), a.apply(accel_raw)))
+        let c = self.calibration_at_f32(t_c)?;
+        Ok(self.apply32(&c, gyro_raw, accel_raw))
     }
 
     /// Checks lengths and every temperature (once per run of equal bit patterns).
@@ -681,11 +759,8 @@ impl CompensationModel {
             let c = self
                 .calibration_at(t)
                 .map_err(|error| BlockError::Sample { index: i, error })?;
-            for g in &mut gyro[i..j] {
-                *g = c.gyro.apply(*g);
-            }
-            for a in &mut accel[i..j] {
-                *a = c.accel.apply(*a);
+            for (g, a) in gyro[i..j].iter_mut().zip(&mut accel[i..j]) {
+                (*g, *a) = self.apply(&c, *g, *a);
             }
             i = j;
         }
@@ -714,14 +789,11 @@ impl CompensationModel {
             while j < t_c.len() && t_c[j].to_bits() == t.to_bits() {
                 j += 1;
             }
-            let [cg, ca] = self
+            let c = self
                 .calibration_at_f32(t)
                 .map_err(|error| BlockError::Sample { index: i, error })?;
-            for g in &mut gyro[i..j] {
-                *g = cg.apply(*g);
-            }
-            for a in &mut accel[i..j] {
-                *a = ca.apply(*a);
+            for (g, a) in gyro[i..j].iter_mut().zip(&mut accel[i..j]) {
+                (*g, *a) = self.apply32(&c, *g, *a);
             }
             i = j;
         }
@@ -785,10 +857,7 @@ impl<'a> Compensator<'a> {
             self.cal = self.model.calibration_at(t_c)?;
             self.last_bits = Some(t_c.to_bits());
         }
-        Ok((
-            self.cal.gyro.apply(gyro_raw),
-            self.cal.accel.apply(accel_raw),
-        ))
+        Ok(self.model.apply(&self.cal, gyro_raw, accel_raw))
     }
 
     /// [`CompensationModel::compensate_f32`] with the cached factors.
@@ -802,8 +871,7 @@ impl<'a> Compensator<'a> {
             self.cal32 = self.model.calibration_at_f32(t_c)?;
             self.last_bits32 = Some(t_c.to_bits());
         }
-        let [g, a] = &self.cal32;
-        Ok((g.apply(gyro_raw), a.apply(accel_raw)))
+        Ok(self.model.apply32(&self.cal32, gyro_raw, accel_raw))
     }
 }
 
@@ -924,6 +992,59 @@ mod tests {
                 .sum::<f64>(),
         );
         e / n
+    }
+
+    /// With the gyro g-sensitivity raw_ω = y(ω) + G·f (counts per m/s²), a model that
+    /// carries G inverts it exactly; block, streaming and f32 paths agree with the
+    /// per-sample one; the model without G leaves G·f in the gyro (what is fixed).
+    #[test]
+    fn compensates_gyro_g_sensitivity() {
+        let (m, g, a) = model(OutOfRange::Error);
+        let gs = Mat3([
+            [0.02, -0.004, 0.001],
+            [0.003, 0.015, -0.002],
+            [0.0, 0.005, 0.03],
+        ]);
+        let mg = m.with_gyro_g_sensitivity(gs).unwrap();
+        assert_eq!(mg.gyro_g_sensitivity(), Some(&gs));
+        let mut gyro = [[0.0; 3]; TEMPS.len()];
+        let mut accel = [[0.0; 3]; TEMPS.len()];
+        let temp = TEMPS;
+        for (i, &t) in TEMPS.iter().enumerate() {
+            let raw_w = add(g.y(W, t), gs.mul_vec(F));
+            let (w, f) = mg.compensate(raw_w, a.y(F, t), t).unwrap();
+            assert!(rel_err(w, W) <= 1e-12, "gyro at {t}: {:e}", rel_err(w, W));
+            assert!(rel_err(f, F) <= 1e-12, "accel at {t}: {:e}", rel_err(f, F));
+            let (w0, _) = m.compensate(raw_w, a.y(F, t), t).unwrap();
+            assert!(
+                rel_err(w0, W) > 1e-4,
+                "without G the error stays: {:e}",
+                rel_err(w0, W)
+            );
+            gyro[i] = raw_w;
+            accel[i] = a.y(F, t);
+        }
+        let (mut bg, mut ba) = (gyro, accel);
+        mg.compensate_block(&mut bg, &mut ba, &temp).unwrap();
+        let mut streaming = Compensator::new(&mg);
+        for i in 0..temp.len() {
+            let want = mg.compensate(gyro[i], accel[i], temp[i]).unwrap();
+            assert_eq!((bg[i], ba[i]), want);
+            assert_eq!(
+                streaming.compensate(gyro[i], accel[i], temp[i]).unwrap(),
+                want
+            );
+            let g32 = gyro[i].map(|v| v as f32);
+            let a32 = accel[i].map(|v| v as f32);
+            let (w32, _) = mg.compensate_f32(g32, a32, temp[i] as f32).unwrap();
+            let w64 = [w32[0] as f64, w32[1] as f64, w32[2] as f64];
+            assert!(rel_err(w64, W) <= 1e-4, "f32 gyro: {:e}", rel_err(w64, W));
+        }
+        let bad = Mat3([[f64::NAN, 0.0, 0.0], [0.0; 3], [0.0; 3]]);
+        assert!(matches!(
+            m.with_gyro_g_sensitivity(bad),
+            Err(CompensationError::InvalidModel(_))
+        ));
     }
 
     #[test]

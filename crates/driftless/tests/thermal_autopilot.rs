@@ -42,6 +42,7 @@ fn adi_like_file(t_ref_c: f64, range_c: [f64; 2]) -> ThermalModelFile {
         t_ref_c,
         range_c,
         out_of_range: "clamp".into(),
+        gyro_g_sensitivity: None,
         accel: section(
             &cfg.accel.bias_poly_m_s2,
             &cfg.accel.scale_factor_poly,

@@ -123,7 +123,9 @@ fn check_coverage(what: &str, hits: usize, n: usize) -> f64 {
     f
 }
 
-fn coverage_run(given_sigma: bool) {
+/// `inflate`: the default rule (covariance × χ²/dof when above 1); off, the σ are taken
+/// as absolute (the pure known-σ case).
+fn coverage_run(given_sigma: bool, inflate: bool) -> (Vec<f64>, f64, f64) {
     const SEEDS: u64 = 1000;
     const SIGMA: f64 = 0.003;
     let t = soak_temps();
@@ -136,19 +138,21 @@ fn coverage_run(given_sigma: bool) {
             .iter()
             .map(|&t| poly(&CUBIC, 25.0, t) + SIGMA * rng.normal())
             .collect();
-        let f = fit(
-            &t,
-            &y,
-            given_sigma.then_some(&s[..]),
-            &FitOptions::default(),
-        )
-        .unwrap();
-        let want = if given_sigma {
-            NoiseScale::Given
-        } else {
-            NoiseScale::Estimated
+        let o = FitOptions {
+            inflate_by_scatter: inflate,
+            ..FitOptions::default()
+        };
+        let f = fit(&t, &y, given_sigma.then_some(&s[..]), &o).unwrap();
+        let chi2_dof = f.chi2_per_dof.unwrap_or(0.0);
+        let want = match (given_sigma, inflate && chi2_dof > 1.0) {
+            (false, _) => NoiseScale::Estimated,
+            (true, false) => NoiseScale::Given,
+            (true, true) => NoiseScale::Inflated,
         };
         assert_eq!(f.noise_scale, want);
+        if want == NoiseScale::Inflated {
+            assert!((f.sigma_scale - chi2_dof.sqrt()).abs() < 1e-12);
+        }
         for (k, hits) in coef_hits.iter_mut().enumerate() {
             let (lo, hi) = f.coeff_interval(k, 0.95).unwrap();
             *hits += usize::from(lo <= CUBIC[k] && CUBIC[k] <= hi);
@@ -160,33 +164,190 @@ fn coverage_run(given_sigma: bool) {
         }
     }
     let n = SEEDS as usize;
+    let frac = |h: usize| h as f64 / n as f64;
+    let pure = !(given_sigma && inflate);
     let coef: Vec<f64> = coef_hits
         .iter()
         .enumerate()
-        .map(|(k, &h)| check_coverage(&format!("c{k}"), h, n))
+        .map(|(k, &h)| {
+            if pure {
+                check_coverage(&format!("c{k}"), h, n)
+            } else {
+                frac(h)
+            }
+        })
         .collect();
     let band: Vec<f64> = band_hits
         .iter()
         .zip(&t)
-        .map(|(&h, tc)| check_coverage(&format!("band at {tc} °C"), h, n))
+        .map(|(&h, tc)| {
+            if pure {
+                check_coverage(&format!("band at {tc} °C"), h, n)
+            } else {
+                frac(h)
+            }
+        })
         .collect();
     let (bmin, bmax) = band
         .iter()
         .fold((1.0f64, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
     eprintln!(
-        "coverage (σ {}): coefficients {coef:.3?}, band min {bmin:.3} max {bmax:.3}",
+        "coverage (σ {}, inflation {inflate}): coefficients {coef:.3?}, band min {bmin:.3} max {bmax:.3}",
         if given_sigma { "given" } else { "estimated" }
     );
+    (coef, bmin, bmax)
 }
 
 #[test]
 fn coverage_with_given_sigma() {
-    coverage_run(true);
+    coverage_run(true, false);
 }
 
 #[test]
 fn coverage_with_estimated_sigma() {
-    coverage_run(false);
+    coverage_run(false, true);
+}
+
+/// With correct σ the default rule inflates only the fits whose χ²/dof exceeds 1 (about
+/// half): intervals get slightly conservative, never narrower than the known-σ ones.
+#[test]
+fn coverage_with_given_sigma_and_scatter_inflation() {
+    let (coef, bmin, bmax) = coverage_run(true, true);
+    for (k, c) in coef.iter().enumerate() {
+        assert!((0.95..=0.99).contains(c), "c{k}: {c}");
+    }
+    assert!(bmin >= 0.95 && bmax <= 0.99, "band {bmin}–{bmax}");
+}
+
+/// σ_i stated 5× too small (the per-bin or per-step σ that ignore the drift between
+/// points): taken as absolute, the 95 % band covers the truth far too rarely; with the
+/// default scatter inflation it covers it as if σ had been estimated, and the fit reports
+/// the ratio.
+#[test]
+fn understated_sigma_is_inflated_to_the_scatter() {
+    const SEEDS: u64 = 400;
+    const SIGMA: f64 = 0.003;
+    let t = soak_temps();
+    let stated = vec![SIGMA / 5.0; t.len()];
+    let (mut hits_abs, mut hits_inf, mut n, mut ratio) = (0usize, 0usize, 0usize, 0.0);
+    for seed in 0..SEEDS {
+        let mut rng = Rng::stream(77, seed);
+        let y: Vec<f64> = t
+            .iter()
+            .map(|&t| poly(&CUBIC, 25.0, t) + SIGMA * rng.normal())
+            .collect();
+        let abs = fit(
+            &t,
+            &y,
+            Some(&stated),
+            &FitOptions {
+                inflate_by_scatter: false,
+                ..FitOptions::default()
+            },
+        )
+        .unwrap();
+        let inf = fit(&t, &y, Some(&stated), &FitOptions::default()).unwrap();
+        assert_eq!(inf.noise_scale, NoiseScale::Inflated);
+        ratio += inf.scatter_ratio.unwrap();
+        for &tc in &t {
+            let truth = poly(&CUBIC, 25.0, tc);
+            let a = abs.band(tc, 0.95).unwrap();
+            let b = inf.band(tc, 0.95).unwrap();
+            hits_abs += usize::from(a.lo <= truth && truth <= a.hi);
+            hits_inf += usize::from(b.lo <= truth && truth <= b.hi);
+            n += 1;
+        }
+    }
+    let (ca, ci) = (hits_abs as f64 / n as f64, hits_inf as f64 / n as f64);
+    let mean_ratio = ratio / SEEDS as f64;
+    eprintln!(
+        "σ stated 5× too small: band coverage {ca:.3} absolute, {ci:.3} inflated; mean ratio {mean_ratio:.2}"
+    );
+    assert!(ca < 0.5, "{ca}");
+    assert!((ci - 0.95).abs() <= 0.03, "{ci}");
+    assert!((mean_ratio - 5.0).abs() < 0.5, "{mean_ratio}");
+}
+
+/// Leave-one-temperature-out: held-out points fall in their 95 % prediction band at the
+/// nominal rate — independent points with σ given or estimated, and points sharing a
+/// drift (a random walk over the visiting order) whose full covariance is given, where
+/// the correlation of the held-out point with the kept ones is part of the band.
+#[test]
+fn held_out_points_fall_in_their_prediction_band() {
+    use driftless::thermal::held_out;
+    const SEEDS: u64 = 300;
+    const SIGMA: f64 = 0.003;
+    let t = soak_temps();
+    let n = t.len();
+    // Random walk of step q per visit, visits in the order k·7 mod n.
+    let q = 0.002;
+    let order: Vec<usize> = (0..n).map(|k| (k * 7) % n).collect();
+    let mut visit = vec![0usize; n];
+    for (k, &i) in order.iter().enumerate() {
+        visit[i] = k + 1;
+    }
+    let mut cov = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..n {
+            cov[i * n + j] = q * q * visit[i].min(visit[j]) as f64;
+        }
+        cov[i * n + i] += SIGMA * SIGMA;
+    }
+    let s = vec![SIGMA; n];
+    let (mut given, mut est, mut corr, mut corr_naive, mut total) = (0, 0, 0, 0, 0);
+    for seed in 0..SEEDS {
+        let mut rng = Rng::stream(99, seed);
+        let white: Vec<f64> = t
+            .iter()
+            .map(|&tc| poly(&CUBIC, 25.0, tc) + SIGMA * rng.normal())
+            .collect();
+        let mut walk = vec![0.0; n];
+        let mut w = 0.0;
+        for &i in &order {
+            w += q * rng.normal();
+            walk[i] = w;
+        }
+        let drifted: Vec<f64> = white.iter().zip(&walk).map(|(a, b)| a + b).collect();
+        let absolute = FitOptions {
+            inflate_by_scatter: false,
+            ..FitOptions::default()
+        };
+        let count = |h: &driftless::thermal::HeldOut| h.inside.iter().filter(|&&b| b).count();
+        given += count(&held_out(&t, &white, Some(&s), None, &absolute, 0.95).unwrap());
+        est += count(&held_out(&t, &white, None, None, &FitOptions::default(), 0.95).unwrap());
+        corr += count(&held_out(&t, &drifted, None, Some(&cov), &absolute, 0.95).unwrap());
+        // The same drifted points with their diagonal only: the drift is unmodelled.
+        let diag: Vec<f64> = (0..n).map(|i| cov[i * n + i].sqrt()).collect();
+        corr_naive += count(&held_out(&t, &drifted, Some(&diag), None, &absolute, 0.95).unwrap());
+        total += n;
+    }
+    let f = |h: usize| h as f64 / total as f64;
+    eprintln!(
+        "held-out coverage: σ given {:.3}, estimated {:.3}, drift covariance {:.3}, drift as diagonal {:.3}",
+        f(given),
+        f(est),
+        f(corr),
+        f(corr_naive)
+    );
+    for (what, c) in [
+        ("given", f(given)),
+        ("estimated", f(est)),
+        ("drift", f(corr)),
+    ] {
+        assert!((c - 0.95).abs() <= 0.02, "{what}: {c}");
+    }
+    let e = held_out(
+        &t,
+        &t,
+        None,
+        None,
+        &FitOptions {
+            order: 5,
+            ..FitOptions::default()
+        },
+        1.5,
+    );
+    assert!(e.is_err());
 }
 
 #[test]

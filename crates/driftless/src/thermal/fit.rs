@@ -125,6 +125,14 @@ pub struct FitOptions {
     /// Student-t coverage factors — for σ_i that are only relative weights. Default
     /// `false`: the σ_i are taken as absolute.
     pub rescale_given_sigma: bool,
+    /// When σ_i are given as absolute: if the points scatter more than they say
+    /// (χ²/dof > 1), multiply the covariance by χ²/dof (the Birge ratio R² =
+    /// χ²/(n − p − 1); Birge, Phys. Rev. 40:207, 1932; the Particle Data Group's scale
+    /// factor) and use Student-t coverage factors — never shrink it when χ²/dof < 1.
+    /// Default `true`: per-step or per-bin σ describe the scatter within a step, not the
+    /// drift between steps, and bands from them alone are narrower than the points'
+    /// spread. The applied factor is [`ThermalFit::sigma_scale`].
+    pub inflate_by_scatter: bool,
 }
 
 impl Default for FitOptions {
@@ -133,6 +141,7 @@ impl Default for FitOptions {
             order: 3,
             t_ref_c: 25.0,
             rescale_given_sigma: false,
+            inflate_by_scatter: true,
         }
     }
 }
@@ -145,6 +154,9 @@ pub enum NoiseScale {
     /// Estimated: s² = RSS_w/(n − p − 1) (RSS_w = χ² when σ_i are given as relative
     /// weights); Student-t coverage factors with n − p − 1 dof.
     Estimated,
+    /// Absolute σ_i whose χ²/dof exceeded 1: Cov = (χ²/dof)·(VᵀWV)⁻¹
+    /// ([`FitOptions::inflate_by_scatter`]); Student-t coverage factors with n − p − 1 dof.
+    Inflated,
 }
 
 /// Result of [`fit`]: y(T) = Σ c_k (T − T_ref)^k with uncertainties.
@@ -174,6 +186,14 @@ pub struct ThermalFit {
     pub n_distinct: usize,
     /// How the covariance is scaled.
     pub noise_scale: NoiseScale,
+    /// Factor applied to the points' σ_i (or, without σ_i, the estimated σ itself): 1 for
+    /// [`NoiseScale::Given`], √(χ²/dof) for [`NoiseScale::Inflated`] and for rescaled
+    /// relative weights, s = √(RSS/(n − p − 1)) without σ_i. The covariance carries its
+    /// square; [`ThermalFit::prediction_band`] uses it for a new point's own scatter.
+    pub sigma_scale: f64,
+    /// Birge ratio √(χ²/dof) observed when σ_i are given (n > p + 1): the points' scatter
+    /// relative to their stated σ, whether or not it was applied.
+    pub scatter_ratio: Option<f64>,
     t_centre: f64,
     half_range: f64,
     /// Scaled coefficients a_j of u^j, u = (T − T_c)/h.
@@ -221,7 +241,30 @@ impl ThermalFit {
         let p = 0.5 * (1.0 + level);
         Ok(match self.noise_scale {
             NoiseScale::Given => normal_quantile(p),
-            NoiseScale::Estimated => student_t_quantile(p, self.dof as f64),
+            NoiseScale::Estimated | NoiseScale::Inflated => student_t_quantile(p, self.dof as f64),
+        })
+    }
+
+    /// Prediction band for a *new* measurement at `t_c` with standard error
+    /// `point_sigma` (the unit of y; `None` without per-point σ: the fit's estimated
+    /// noise): ŷ ± k·√(σ_fit(T)² + (λ·σ_point)²), λ = [`ThermalFit::sigma_scale`], k as
+    /// for [`ThermalFit::band`]. This is the band a held-out point should fall in; the
+    /// confidence band [`ThermalFit::band`] is that of the curve alone.
+    pub fn prediction_band(
+        &self,
+        t_c: f64,
+        level: f64,
+        point_sigma: Option<f64>,
+    ) -> Result<BandPoint, ThermalFitError> {
+        let k = self.coverage_factor(level)?;
+        let value = self.eval(t_c);
+        let own = self.sigma_scale * point_sigma.unwrap_or(1.0);
+        let s = (self.std_error_at(t_c).powi(2) + own * own).sqrt();
+        Ok(BandPoint {
+            value,
+            std_error: s,
+            lo: value - k * s,
+            hi: value + k * s,
         })
     }
 
@@ -344,6 +387,16 @@ fn distinct_groups(t_c: &[f64]) -> Vec<Vec<usize>> {
         }
     }
     groups
+}
+
+/// `keep` ← the indices of every group but group `g`.
+fn all_but(groups: &[Vec<usize>], g: usize, keep: &mut Vec<usize>) {
+    keep.clear();
+    for (h, other) in groups.iter().enumerate() {
+        if h != g {
+            keep.extend_from_slice(other);
+        }
+    }
 }
 
 /// Weighted least squares on u = (T − T_c)/h over the points `idx` by Householder QR
@@ -574,7 +627,7 @@ fn fit_impl(
     let n = t_c.len();
     let m = order + 1;
     let dof = n - m;
-    let noise_scale = match sigma {
+    let mut noise_scale = match sigma {
         Some(_) if !opts.rescale_given_sigma => NoiseScale::Given,
         _ => NoiseScale::Estimated,
     };
@@ -585,9 +638,16 @@ fn fit_impl(
     // With a full covariance the whitening carries the weights.
     let row_sigma = if chol.is_some() { None } else { sigma };
     let core = solve_scaled_whitened(t_c, y, row_sigma, chol, &idx, m)?;
+    let birge2 = (sigma.is_some() && dof > 0).then(|| core.rss_w / dof as f64);
+    if noise_scale == NoiseScale::Given
+        && opts.inflate_by_scatter
+        && birge2.is_some_and(|r2| r2 > 1.0)
+    {
+        noise_scale = NoiseScale::Inflated;
+    }
     let s2 = match noise_scale {
         NoiseScale::Given => 1.0,
-        NoiseScale::Estimated => core.rss_w / dof as f64,
+        NoiseScale::Estimated | NoiseScale::Inflated => core.rss_w / dof as f64,
     };
     // Cov(a) = s² R⁻¹ R⁻ᵀ.
     let mut cov_a = vec![0.0; m * m];
@@ -645,6 +705,8 @@ fn fit_impl(
         n_points: n,
         n_distinct,
         noise_scale,
+        sigma_scale: s2.sqrt(),
+        scatter_ratio: birge2.map(f64::sqrt),
         t_centre: core.t_centre,
         half_range: core.half_range,
         coeffs_scaled: core.a,
@@ -687,12 +749,7 @@ pub fn cross_validate(
     let mut residuals = vec![0.0; n];
     let mut keep = Vec::with_capacity(n);
     for (g, group) in groups.iter().enumerate() {
-        keep.clear();
-        for (h, other) in groups.iter().enumerate() {
-            if h != g {
-                keep.extend_from_slice(other);
-            }
-        }
+        all_but(&groups, g, &mut keep);
         let core = solve_scaled(t_c, y, sigma, &keep, order + 1)?;
         for &i in group {
             residuals[i] = y[i] - horner_scaled(&core.a, core.t_centre, core.half_range, t_c[i]);
@@ -704,6 +761,179 @@ pub fn cross_validate(
         residuals,
         rms,
     })
+}
+
+/// Held-out check of a fit's uncertainty ([`held_out`]): each point predicted by the fit
+/// without its temperature, and the standard error that prediction error should have.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeldOut {
+    /// Order p.
+    pub order: usize,
+    /// Prediction error e_i = y_i − ŷ_{−T_i}(T_i) of each input point (input order).
+    pub residuals: Vec<f64>,
+    /// Its standard error under the fit's noise model (module docs of [`held_out`]).
+    pub std_errors: Vec<f64>,
+    /// Coverage factor used for each point (normal, or Student-t with the reduced fit's
+    /// residual dof when the noise scale was estimated or inflated).
+    pub coverage_factors: Vec<f64>,
+    /// |e_i| ≤ k_i·σ(e_i).
+    pub inside: Vec<bool>,
+}
+
+impl HeldOut {
+    /// Fraction of points inside their band.
+    pub fn coverage(&self) -> f64 {
+        let n = self.inside.len().max(1) as f64;
+        self.inside.iter().filter(|&&b| b).count() as f64 / n
+    }
+}
+
+/// Leave-one-temperature-out check of the *uncertainty*, not only of the curve: for each
+/// distinct temperature, the fit is made again (same order, weights, covariance and
+/// noise-scale rule as [`fit`] / [`fit_correlated`] with `opts`) without every point at
+/// it, and each held-out point is compared with its prediction band at `level`.
+///
+/// With C the points' covariance (`covariance` n×n row-major; else diag(σ_i²); else I),
+/// K the kept points, A_K their design and ŷ_i = g_iᵀ(A_KᵀC_KK⁻¹A_K)⁻¹A_KᵀC_KK⁻¹ y_K, the
+/// prediction error e_i = y_i − ŷ_i has, exactly,
+///
+/// ```text
+/// Var(e_i) = s²·( C_ii − 2 g_iᵀ(AᵀC⁻¹A)⁻¹AᵀC⁻¹ C_Ki + g_iᵀ(AᵀC⁻¹A)⁻¹ g_i )
+/// ```
+///
+/// — the middle term is the correlation of the held-out point with the kept ones (a
+/// shared drift), zero for independent points — with s² = 1 for absolute σ, the reduced
+/// fit's χ²/dof when it is estimated or inflated ([`FitOptions::inflate_by_scatter`]).
+/// A well-calibrated noise model puts ≈ `level` of the points inside; far fewer means
+/// the σ are too small, far more that they are too large.
+pub fn held_out(
+    t_c: &[f64],
+    y: &[f64],
+    sigma: Option<&[f64]>,
+    covariance: Option<&[f64]>,
+    opts: &FitOptions,
+    level: f64,
+) -> Result<HeldOut, ThermalFitError> {
+    if !(level > 0.0 && level < 1.0) {
+        return Err(ThermalFitError::BadLevel(level));
+    }
+    let n = t_c.len();
+    let order = opts.order;
+    let m = order + 1;
+    if let Some(c) = covariance
+        && c.len() != n * n
+    {
+        return Err(ThermalFitError::LengthMismatch {
+            what: "covariance (n×n)",
+            expected: n * n,
+            got: c.len(),
+        });
+    }
+    let diag: Option<Vec<f64>> = covariance.map(|c| (0..n).map(|i| c[i * n + i].sqrt()).collect());
+    let sig = diag.as_deref().or(sigma);
+    let distinct = validate(t_c, y, sig, order, opts.t_ref_c)?;
+    if distinct < order + 2 {
+        return Err(ThermalFitError::TooFewTemperatures {
+            distinct: distinct - 1,
+            order,
+        });
+    }
+    let cfull: Vec<f64> = match (covariance, sig) {
+        (Some(c), _) => c.to_vec(),
+        (None, s) => {
+            let mut c = vec![0.0; n * n];
+            for i in 0..n {
+                c[i * n + i] = s.map_or(1.0, |s| s[i] * s[i]);
+            }
+            c
+        }
+    };
+    let estimated = sig.is_none() || opts.rescale_given_sigma;
+    let p = 0.5 * (1.0 + level);
+    let groups = distinct_groups(t_c);
+    let mut out = HeldOut {
+        order,
+        residuals: vec![0.0; n],
+        std_errors: vec![0.0; n],
+        coverage_factors: vec![0.0; n],
+        inside: vec![false; n],
+    };
+    let mut keep = Vec::with_capacity(n);
+    for (g, group) in groups.iter().enumerate() {
+        all_but(&groups, g, &mut keep);
+        let nk = keep.len();
+        let ck: Vec<f64> = (0..nk * nk)
+            .map(|q| cfull[keep[q / nk] * n + keep[q % nk]])
+            .collect();
+        let l = cholesky(&ck, nk).ok_or(ThermalFitError::CovarianceNotPositiveDefinite)?;
+        let core = solve_scaled_whitened(t_c, y, None, Some(&l), &keep, m)?;
+        let dof = nk - m;
+        let r2 = if dof > 0 {
+            core.rss_w / dof as f64
+        } else {
+            f64::NAN
+        };
+        let scaled = estimated || (opts.inflate_by_scatter && r2 > 1.0);
+        if scaled && dof == 0 {
+            return Err(ThermalFitError::NoResidualDof { points: nk, order });
+        }
+        let (s2, k) = if scaled {
+            (r2, student_t_quantile(p, dof as f64))
+        } else {
+            (1.0, normal_quantile(p))
+        };
+        // (AᵀC⁻¹A)⁻¹ = R⁻¹R⁻ᵀ on the scaled basis, and the whitened design Ã = L⁻¹A.
+        let cov_a: Vec<f64> = (0..m * m)
+            .map(|q| {
+                let (i, j) = (q / m, q % m);
+                (i.max(j)..m)
+                    .map(|r| core.r_inv[i * m + r] * core.r_inv[j * m + r])
+                    .sum()
+            })
+            .collect();
+        let basis = |t: f64| -> Vec<f64> {
+            let u = (t - core.t_centre) / core.half_range;
+            let mut gv = vec![1.0; m];
+            for j in 1..m {
+                gv[j] = gv[j - 1] * u;
+            }
+            gv
+        };
+        let mut aw = vec![0.0; nk * m];
+        let mut col = vec![0.0; nk];
+        for j in 0..m {
+            for (r, &i) in keep.iter().enumerate() {
+                col[r] = basis(t_c[i])[j];
+            }
+            forward_substitute(&l, nk, &mut col);
+            for r in 0..nk {
+                aw[r * m + j] = col[r];
+            }
+        }
+        for &i in group {
+            let gi = basis(t_c[i]);
+            let mut v: Vec<f64> = keep.iter().map(|&r| cfull[r * n + i]).collect();
+            forward_substitute(&l, nk, &mut v);
+            let q: Vec<f64> = (0..m)
+                .map(|j| (0..nk).map(|r| aw[r * m + j] * v[r]).sum())
+                .collect();
+            let (mut cross, mut fitv) = (0.0, 0.0);
+            for a in 0..m {
+                for b in 0..m {
+                    cross += gi[a] * cov_a[a * m + b] * q[b];
+                    fitv += gi[a] * cov_a[a * m + b] * gi[b];
+                }
+            }
+            let var = s2 * (cfull[i * n + i] - 2.0 * cross + fitv).max(0.0);
+            let e = y[i] - horner_scaled(&core.a, core.t_centre, core.half_range, t_c[i]);
+            let sd = var.sqrt();
+            out.residuals[i] = e;
+            out.std_errors[i] = sd;
+            out.coverage_factors[i] = k;
+            out.inside[i] = e.abs() <= k * sd;
+        }
+    }
+    Ok(out)
 }
 
 /// One candidate order in [`OrderAdvice`].
@@ -777,6 +1007,7 @@ pub fn advise_order(
             order,
             t_ref_c,
             rescale_given_sigma: false,
+            inflate_by_scatter: false,
         };
         let f = fit(t_c, y, sigma, &opts)?;
         let cv = cross_validate(t_c, y, sigma, &opts)?;

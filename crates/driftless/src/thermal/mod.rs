@@ -12,12 +12,15 @@
 //!   binned medians (robust to quantised temperature and uneven heating), hysteresis.
 //! * [`soak`]: the soak method — six-position + rate-table calibration at every set
 //!   temperature of a chamber recording, then a weighted fit of each bias and scale series.
+//! * [`check`]: checks of a log before a fit (temperature rise and resolution, heating-rate
+//!   profile, motion, gaps) with a verdict per method.
 //! * [`autopilot`]: export of a model's bias part to PX4 `TC_*` and ArduPilot `INS_TCAL*`
 //!   parameter files, their import, and each autopilot's correction formula.
 //!
 //! Algorithms only: no file I/O here.
 
 pub mod autopilot;
+pub mod check;
 pub mod fit;
 pub mod model_file;
 pub mod ramp;
@@ -25,6 +28,7 @@ pub mod soak;
 pub mod stats;
 
 pub use fit::{
-    BIC_PARSIMONY, BandPoint, CrossValidation, FitOptions, NoiseScale, OrderAdvice, OrderRow,
-    ThermalFit, ThermalFitError, advise_order, cross_validate, fit, fit_correlated,
+    BIC_PARSIMONY, BandPoint, CrossValidation, FitOptions, HeldOut, NoiseScale, OrderAdvice,
+    OrderRow, ThermalFit, ThermalFitError, advise_order, cross_validate, fit, fit_correlated,
+    held_out,
 };

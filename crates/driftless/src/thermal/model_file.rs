@@ -5,11 +5,13 @@
 //! [`driftless_model::compensation::CompensationModel`] (whose doc states the equation).
 //!
 //! ```toml
-//! format_version = 1
+//! format_version = 2
 //! model_id = 7
 //! t_ref_c = 25.0
 //! range_c = [-25.0, 70.0]
 //! out_of_range = "clamp"          # clamp | extrapolate | error
+//! # optional: gyro g-sensitivity G, raw gyro units per m/s² (raw_ω = A·ω + b + G·f)
+//! gyro_g_sensitivity = [[1e-4, 0.0, 0.0], [0.0, 1e-4, 0.0], [0.0, 0.0, 2e-4]]
 //!
 //! [accel]
 //! raw_unit = "m/s^2"
@@ -18,6 +20,8 @@
 //! bias_delta = [[0.0, 1e-3, 2e-6, -1e-7], …]   # per axis: c0 (= 0), c1 °C⁻¹, c2, c3 …
 //! scale_delta = [[0.0, 2e-5, 0.0, 0.0], …]      # dimensionless per °C^k
 //! ```
+//!
+//! Version 2 added `gyro_g_sensitivity`; version-1 files (without it) still read.
 
 use std::path::Path;
 
@@ -28,8 +32,11 @@ use driftless_model::compensation::{CompensationModel, OutOfRange, TriadThermal}
 use driftless_model::linalg::Mat3;
 use driftless_model::thermal::ThermalPoly;
 
-/// Current format version.
-pub const FORMAT_VERSION: u32 = 1;
+/// Current format version (2: optional `gyro_g_sensitivity`).
+pub const FORMAT_VERSION: u32 = 2;
+
+/// Oldest format version still read (1: no g-sensitivity).
+pub const OLDEST_FORMAT_VERSION: u32 = 1;
 
 /// One triad of the file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -62,6 +69,10 @@ pub struct ThermalModelFile {
     pub range_c: [f64; 2],
     /// `clamp`, `extrapolate` or `error`.
     pub out_of_range: String,
+    /// Gyro g-sensitivity G, raw gyro units per m/s² (raw_ω = A·ω + b + G·f), applied
+    /// with the compensated specific force; absent: none compensated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gyro_g_sensitivity: Option<[[f64; 3]; 3]>,
     /// Accelerometer.
     pub accel: TriadSection,
     /// Gyroscope.
@@ -124,6 +135,7 @@ impl ThermalModelFile {
             t_ref_c: t_ref,
             range_c: m.range_c(),
             out_of_range: policy_name(m.policy()).into(),
+            gyro_g_sensitivity: m.gyro_g_sensitivity().map(|g| g.0),
             accel: section(&m.calibration().accel, m.accel(), units[0]),
             gyro: section(&m.calibration().gyro, m.gyro(), units[1]),
         }
@@ -135,9 +147,10 @@ impl ThermalModelFile {
             path: path.to_owned(),
             message,
         };
-        if self.format_version != FORMAT_VERSION {
+        if !(OLDEST_FORMAT_VERSION..=FORMAT_VERSION).contains(&self.format_version) {
             return Err(bad(format!(
-                "format_version {} is not supported (this driftless reads {FORMAT_VERSION})",
+                "format_version {} is not supported (this driftless reads \
+                 {OLDEST_FORMAT_VERSION} to {FORMAT_VERSION})",
                 self.format_version
             )));
         }
@@ -178,7 +191,7 @@ impl ThermalModelFile {
         };
         let (ca, ta) = triad("accel", &self.accel)?;
         let (cg, tg) = triad("gyro", &self.gyro)?;
-        CompensationModel::new(
+        let model = CompensationModel::new(
             self.model_id,
             ImuCalibration {
                 accel: ca,
@@ -189,7 +202,13 @@ impl ThermalModelFile {
             self.range_c,
             policy,
         )
-        .map_err(|e| bad(e.to_string()))
+        .map_err(|e| bad(e.to_string()))?;
+        match self.gyro_g_sensitivity {
+            Some(g) => model
+                .with_gyro_g_sensitivity(Mat3(g))
+                .map_err(|e| bad(format!("gyro_g_sensitivity: {e}"))),
+            None => Ok(model),
+        }
     }
 
     /// Reads a file and builds its model.

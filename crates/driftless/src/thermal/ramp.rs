@@ -338,6 +338,7 @@ impl RampCalibration {
             t_ref_c,
             range_c: [lo, hi],
             out_of_range: "clamp".into(),
+            gyro_g_sensitivity: None,
             accel: section(accel, "m/s^2", false)?,
             gyro: section(gyro, "rad/s", true)?,
         })

@@ -22,9 +22,10 @@
 //! [`SixPositionOptions::from_manifest`] sets it whenever every step's static positions
 //! identify G (each axis up and down; [`crate::calib::six_position`] module docs) — and
 //! the result reports it per step ([`SoakCalibration::gyro_g_sensitivity`], with σ) and
-//! as an inverse-variance mean ([`SoakCalibration::gyro_g_sensitivity_mean`]). It is not
-//! part of the compensation model (which has no G term); the bias series are the
-//! zero-g biases b_k(T).
+//! as an inverse-variance mean ([`SoakCalibration::gyro_g_sensitivity_mean`]), which the
+//! compensation model carries ([`SoakCalibration::compensation_model`]; applied with the
+//! compensated specific force, [`driftless_model::compensation`]). The bias series are
+//! the zero-g biases b_k(T).
 //!
 //! The temperature of each point is the set temperature (the protocol soaks until the
 //! sensor has settled; the manifest's soak is sized for that).
@@ -143,6 +144,10 @@ pub struct SeriesFit {
     pub values: Vec<f64>,
     /// Their standard errors.
     pub sigma: Vec<f64>,
+    /// The full covariance of the values the fit used (n×n row-major, the drift model
+    /// plus σ² on the diagonal) when the series was fitted by generalised least squares;
+    /// `None` for a weighted (or, with a zero σ, unweighted) fit.
+    pub covariance: Option<Vec<f64>>,
     /// The fit.
     pub fit: ThermalFit,
 }
@@ -258,7 +263,8 @@ impl SoakCalibration {
     /// calibration at T_ref — M from the six-position estimate at the set temperature
     /// nearest T_ref, b from the bias fits' value at T_ref — and the thermal deltas of
     /// the fits, Δb(T) = b(T) − b(T_ref), Δs(T) = (A_kk(T) − A_kk(T_ref))/A_kk(T_ref),
-    /// valid over the soaked range.
+    /// valid over the soaked range; with the gyro g-sensitivity G
+    /// ([`Self::gyro_g_sensitivity_mean`]) when every step estimated it.
     pub fn compensation_model(
         &self,
         id: u64,
@@ -328,7 +334,7 @@ impl SoakCalibration {
                 }
             }
         }
-        CompensationModel::new(
+        let model = CompensationModel::new(
             id,
             ImuCalibration {
                 accel: rooms[0],
@@ -339,7 +345,14 @@ impl SoakCalibration {
             range,
             policy,
         )
-        .map_err(invalid)
+        .map_err(invalid)?;
+        // The gyro g-sensitivity, when every step estimated it: the inverse-variance mean.
+        match self.gyro_g_sensitivity_mean() {
+            Some(g) => model
+                .with_gyro_g_sensitivity(g.matrix_raw_per_m_s2)
+                .map_err(invalid),
+            None => Ok(model),
+        }
     }
 
     /// Inverse-variance weighted mean of the per-step g-sensitivity, entry by entry:
@@ -377,6 +390,40 @@ impl SoakCalibration {
         Some(GSensitivityEstimate {
             matrix_raw_per_m_s2: mean,
             sigma_raw_per_m_s2: sigma,
+        })
+    }
+
+    /// Leave-one-temperature-out check of a series' uncertainty ([`super::fit::held_out`]):
+    /// each step predicted by the fit without its temperature, with the same weights,
+    /// drift covariance and noise-scale rule (`fit_opts`, as given to
+    /// [`soak_calibration`]), against its `level` prediction band.
+    pub fn held_out(
+        &self,
+        series: &SeriesFit,
+        fit_opts: &FitOptions,
+        level: f64,
+    ) -> Result<super::fit::HeldOut, SoakError> {
+        let weights = series
+            .sigma
+            .iter()
+            .all(|s| *s > 0.0)
+            .then_some(series.sigma.as_slice());
+        super::fit::held_out(
+            &self.temperatures_c,
+            &series.values,
+            weights,
+            series.covariance.as_deref(),
+            fit_opts,
+            level,
+        )
+        .map_err(|source| SoakError::Fit {
+            what: format!(
+                "{} {} {} held out",
+                series.triad,
+                series.quantity,
+                ["x", "y", "z"][series.axis]
+            ),
+            source,
         })
     }
 
@@ -490,16 +537,20 @@ pub fn soak_calibration(
                     .filter(|d| quantity == "bias" && *d != ChannelDrift::default());
                 // A zero σ (noise-free data) cannot weight a fit: use unit weights then.
                 let weights = sigma.iter().all(|s| *s > 0.0).then_some(sigma.as_slice());
-                let f = match (channel_drift, weights) {
+                let covariance = match (channel_drift, weights) {
                     (Some(d), Some(w)) => {
                         let n = temps.len();
                         let mut c = drift_covariance(&times, &d, average_s, span_s);
                         for i in 0..n {
                             c[i * n + i] += w[i] * w[i];
                         }
-                        fit_correlated(&temps, &values, &c, fit_opts)
+                        Some(c)
                     }
-                    _ => fit(&temps, &values, weights, fit_opts),
+                    _ => None,
+                };
+                let f = match &covariance {
+                    Some(c) => fit_correlated(&temps, &values, c, fit_opts),
+                    None => fit(&temps, &values, weights, fit_opts),
                 }
                 .map_err(|source| SoakError::Fit { what, source })?;
                 series.push(SeriesFit {
@@ -508,6 +559,7 @@ pub fn soak_calibration(
                     axis,
                     values,
                     sigma,
+                    covariance,
                     fit: f,
                 });
             }
