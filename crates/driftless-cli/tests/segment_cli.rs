@@ -29,14 +29,14 @@ fn soak_without_manifest() {
         &dir,
         "sim",
         &chamber(
-            "temperatures_c = [-10.0, 10.0, 30.0, 50.0, 70.0]\n\
-             skip_positions = [{ set_temperature_c = 30.0, up = \"+x\" }]\n",
+            "temperatures_c = [-10.0, 5.0, 20.0, 35.0, 50.0, 65.0]\n\
+             skip_positions = [{ set_temperature_c = 35.0, up = \"+x\" }]\n",
         ),
     );
     let site = ["--lat-deg", "51.08", "--height-m", "1100"];
     let v = run_json(
         bin()
-            .args(["thermal", "soak", "--json", "--order", "2"])
+            .args(["thermal", "soak", "--json", "--order", "3"])
             .args(site)
             .arg(sim.join("imu.csv")),
     );
@@ -51,24 +51,24 @@ fn soak_without_manifest() {
     assert_eq!(missing[0]["up"], "+x");
     let p = missing[0]["plateau"].as_u64().unwrap() as usize;
     let t = seg["plateaus"][p]["temperature_c"].as_f64().unwrap();
-    assert!((t - 30.0).abs() < 0.01, "{t}");
+    assert!((t - 35.0).abs() < 0.01, "{t}");
     assert!(missing[0]["end_s"].as_f64().unwrap() > missing[0]["start_s"].as_f64().unwrap());
-    // The step without +x is left out: four temperatures in the fit.
+    // The step without +x is left out: five temperatures in the fit.
     let temps: Vec<f64> = v["temperatures_c"]
         .as_array()
         .unwrap()
         .iter()
         .map(|x| x.as_f64().unwrap())
         .collect();
-    assert_eq!(temps.len(), 4, "{temps:?}");
+    assert_eq!(temps.len(), 5, "{temps:?}");
     // Against the manifest run without that step: every coefficient within 1σ.
     let text = std::fs::read_to_string(sim.join("manifest.toml")).unwrap();
     let mut m = driftless::sim::chamber_manifest::ChamberManifest::from_toml_str(&text).unwrap();
-    m.segments.retain(|s| s.set_temperature_c != 30.0);
+    m.segments.retain(|s| s.set_temperature_c != 35.0);
     std::fs::write(dir.join("reduced.toml"), m.to_toml_string().unwrap()).unwrap();
     let w = run_json(
         bin()
-            .args(["thermal", "soak", "--json", "--order", "2", "--manifest"])
+            .args(["thermal", "soak", "--json", "--order", "3", "--manifest"])
             .arg(dir.join("reduced.toml"))
             .arg(sim.join("imu.csv")),
     );
@@ -84,7 +84,7 @@ fn soak_without_manifest() {
             (&a["triad"], &a["quantity"], &a["axis"]),
             (&b["triad"], &b["quantity"], &b["axis"])
         );
-        for k in 0..3 {
+        for k in 0..4 {
             let (ca, cb) = (
                 a["coefficients"][k].as_f64().unwrap(),
                 b["coefficients"][k].as_f64().unwrap(),
@@ -97,7 +97,7 @@ fn soak_without_manifest() {
     assert!(worst <= 1.0, "{worst}");
     // Text mode: the table, the finding with its span, the step left out.
     let out = bin()
-        .args(["thermal", "soak", "--order", "2"])
+        .args(["thermal", "soak", "--order", "3"])
         .args(site)
         .arg(sim.join("imu.csv"))
         .output()

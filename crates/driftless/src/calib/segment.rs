@@ -19,7 +19,9 @@
 //! triads). A sample is *quiet* when ς_a < k·med(ς_a) and ς_g < k·med(ς_g), med the median
 //! over the log: a chamber or turntable log is mostly static or turning at a constant
 //! rate, and both leave only the sensor noise in the window. No initial rest period is
-//! needed. A run of quiet samples is then, by its mean rate ‖ω̄‖:
+//! needed. A run of quiet samples is grown at each end while every sample of both triads
+//! stays within 4σ of the run's mean (the centred window leaves out up to half a window
+//! at each edge), and is then, by its mean rate ‖ω̄‖:
 //!
 //! * **static** when ‖ω̄‖ < `static_max_rate_deg_s` (a sensor bias, not motion). The axis
 //!   up is the body axis j whose ±e_j is within `orientation_tolerance_deg` of the mean
@@ -656,6 +658,8 @@ pub fn segment_log(
         if b - a < min_static.min(min_rot) {
             continue;
         }
+        let (a, b) = extend_run(inp, a, b, (opts.window_s * fs).round() as usize);
+        k0 = k0.max(b);
         let w = sums.gyro(a, b);
         let rate_deg_s = norm(w).to_degrees();
         if rate_deg_s < opts.static_max_rate_deg_s {
@@ -856,6 +860,39 @@ pub fn segment_log(
     seg.findings
         .sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
     Ok(seg)
+}
+
+/// The run `a..b` grown sample by sample at each end, by at most `max` samples, while
+/// every channel of both triads stays within 4σ of the run's mean (σ the run's own
+/// sample standard deviation, floored at 1e-6 m/s² and 1e-5 rad/s for noise-free data):
+/// the centred variance window leaves out up to half a window at each edge, which a
+/// rotation of a whole number of revolutions needs back.
+fn extend_run(inp: &SegmentInput, a: usize, b: usize, max: usize) -> (usize, usize) {
+    let n = inp.time_s.len();
+    let cols: Vec<&[f64]> = inp.accel_m_s2.iter().chain(&inp.gyro_rad_s).copied().collect();
+    let stats: Vec<(f64, f64)> = cols
+        .iter()
+        .enumerate()
+        .map(|(j, c)| {
+            let x = &c[a..b];
+            let m = x.iter().sum::<f64>() / x.len() as f64;
+            let v = x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (x.len().max(2) - 1) as f64;
+            (m, v.sqrt().max(if j < 3 { 1e-6 } else { 1e-5 }))
+        })
+        .collect();
+    let fits = |k: usize| {
+        cols.iter()
+            .zip(&stats)
+            .all(|(c, &(m, s))| (c[k] - m).abs() <= 4.0 * s)
+    };
+    let (mut lo, mut hi) = (a, b);
+    while lo > 0 && a - lo < max && fits(lo - 1) {
+        lo -= 1;
+    }
+    while hi < n && hi - b < max && fits(hi) {
+        hi += 1;
+    }
+    (lo, hi)
 }
 
 /// Soaks (module docs): statics longer than 3× the median position length D; one
