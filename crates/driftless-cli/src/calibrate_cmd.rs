@@ -340,7 +340,12 @@ fn six(s: SixArgs) -> Result<()> {
     let (manifest, temp, source, segmentation) = match &s.manifest {
         Some(path) => {
             let (m, t) = six_manifest(&s, path)?;
-            (m, t, format!("{} + {}", s.log.display(), path.display()), None)
+            (
+                m,
+                t,
+                format!("{} + {}", s.log.display(), path.display()),
+                None,
+            )
         }
         None => six_segmented(&s, &log)?,
     };

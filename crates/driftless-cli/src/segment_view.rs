@@ -100,9 +100,8 @@ fn print_table(seg: &Segmentation, path: &Path) {
         seg.n_samples,
         seg.sample_rate_hz
     );
-    let mut tab = crate::output::Table::new([
-        "segment", "start [s]", "end [s]", "what", "up", "plateau",
-    ]);
+    let mut tab =
+        crate::output::Table::new(["segment", "start [s]", "end [s]", "what", "up", "plateau"]);
     let plateau = |p: Option<usize>| p.map_or("–".to_string(), |p| p.to_string());
     let mut rows: Vec<(f64, Vec<String>)> = Vec::new();
     for s in &seg.statics {

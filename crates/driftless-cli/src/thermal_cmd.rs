@@ -319,8 +319,8 @@ fn soak_manifest(
     log: &driftless::io::ImuLog,
 ) -> Result<(ChamberManifest, Option<serde_json::Value>)> {
     if let Some(path) = &s.manifest {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("reading {}", path.display()))?;
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
         let manifest =
             ChamberManifest::from_toml_str(&text).with_context(|| format!("{}", path.display()))?;
         return Ok((manifest, None));

@@ -8,8 +8,7 @@
 //! Figures print with `--nocapture`.
 
 use driftless::calib::segment::{
-    FindingKind, SegmentInput, SegmentOptions, Segmentation, SiteConstants, StaticRole,
-    segment_log,
+    FindingKind, SegmentInput, SegmentOptions, Segmentation, SiteConstants, StaticRole, segment_log,
 };
 use driftless::calib::six_position::{SixPositionInput, SixPositionOptions, calibrate};
 use driftless::sim::chamber::{
@@ -122,10 +121,7 @@ fn six_position_z(p: &ChamberProtocol, out: &SensorOutput, seg: &Segmentation) -
     )
     .expect("calibrate");
     let mut worst: f64 = 0.0;
-    for (a, b) in [
-        (&with.accel, &without.accel),
-        (&with.gyro, &without.gyro),
-    ] {
+    for (a, b) in [(&with.accel, &without.accel), (&with.gyro, &without.gyro)] {
         let (sb, sm) = (a.bias_sigma(), a.matrix_sigma());
         for i in 0..3 {
             worst = worst.max((a.calibration.bias[i] - b.calibration.bias[i]).abs() / sb[i]);
@@ -150,8 +146,7 @@ fn six_position_without_manifest_matches_the_manifest() {
         assert_eq!(seg.steps().len(), 1);
         assert!(seg.plateaus[seg.steps()[0]].complete());
         assert!(
-            !seg
-                .findings
+            !seg.findings
                 .iter()
                 .any(|f| matches!(f.kind, FindingKind::MissingPosition { .. })),
             "{:?}",

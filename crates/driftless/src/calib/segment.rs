@@ -365,9 +365,7 @@ pub enum SegmentError {
     #[error("{0}")]
     BadInput(String),
     /// A NaN or infinity in a column.
-    #[error(
-        "non-finite {column} at sample {sample} (t = {time_s} s): repair or remove that row"
-    )]
+    #[error("non-finite {column} at sample {sample} (t = {time_s} s): repair or remove that row")]
     NonFinite {
         /// Column name.
         column: String,
@@ -857,8 +855,7 @@ pub fn segment_log(
         findings,
     };
     assign_plateaus(&mut seg, inp, &plateaus_spans, opts, &span, &sums);
-    seg.findings
-        .sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
+    seg.findings.sort_by(|a, b| a.start_s.total_cmp(&b.start_s));
     Ok(seg)
 }
 
@@ -869,7 +866,12 @@ pub fn segment_log(
 /// rotation of a whole number of revolutions needs back.
 fn extend_run(inp: &SegmentInput, a: usize, b: usize, max: usize) -> (usize, usize) {
     let n = inp.time_s.len();
-    let cols: Vec<&[f64]> = inp.accel_m_s2.iter().chain(&inp.gyro_rad_s).copied().collect();
+    let cols: Vec<&[f64]> = inp
+        .accel_m_s2
+        .iter()
+        .chain(&inp.gyro_rad_s)
+        .copied()
+        .collect();
     let stats: Vec<(f64, f64)> = cols
         .iter()
         .enumerate()
@@ -1262,9 +1264,8 @@ impl Segmentation {
         site: &SiteConstants,
     ) -> Result<(ChamberManifest, Vec<&Finding>), SegmentError> {
         let steps = self.steps();
-        let (complete, left): (Vec<usize>, Vec<usize>) = steps
-            .iter()
-            .partition(|&&p| self.plateaus[p].complete());
+        let (complete, left): (Vec<usize>, Vec<usize>) =
+            steps.iter().partition(|&&p| self.plateaus[p].complete());
         if complete.is_empty() {
             return Err(SegmentError::Incomplete(self.incomplete_message(&left)));
         }
@@ -1413,13 +1414,24 @@ mod tests {
             SignedAxis::new(BodyAxis::Y, true),
             SignedAxis::new(BodyAxis::X, true),
         );
-        assert_eq!(ups, vec![Some(zd), Some(yu), Some(xu), None], "{:?}", s.statics);
+        assert_eq!(
+            ups,
+            vec![Some(zd), Some(yu), Some(xu), None],
+            "{:?}",
+            s.statics
+        );
         // Trimmed by 0.2 s at each end, within a window of the true edges.
         let first = s.statics[0].span;
-        assert!(first.start_s <= 0.25 && (19.0..=19.8).contains(&first.end_s), "{first:?}");
+        assert!(
+            first.start_s <= 0.25 && (19.0..=19.8).contains(&first.end_s),
+            "{first:?}"
+        );
         assert_eq!(s.rotations.len(), 1);
         let rot = &s.rotations[0];
-        assert_eq!((rot.axis, rot.up, rot.usable), (BodyAxis::X, Some(xu), true));
+        assert_eq!(
+            (rot.axis, rot.up, rot.usable),
+            (BodyAxis::X, Some(xu), true)
+        );
         assert_eq!(rot.commanded_rate_rad_s, Some(r));
         // Two revolutions less up to a window at the abrupt edges of this log.
         assert!(
@@ -1446,7 +1458,11 @@ mod tests {
             .map(|f| f.message.as_str())
             .collect();
         assert_eq!(ambiguous.len(), 2, "{ambiguous:?}");
-        assert!(ambiguous[0].contains("20.0° from +y up"), "{}", ambiguous[0]);
+        assert!(
+            ambiguous[0].contains("20.0° from +y up"),
+            "{}",
+            ambiguous[0]
+        );
         assert!(ambiguous[1].contains("4.00 deg/s"), "{}", ambiguous[1]);
         assert!(s.findings.iter().any(|f| matches!(
             f.kind,
@@ -1470,7 +1486,11 @@ mod tests {
         )
         .expect("segment");
         assert!(!s.rotations[0].usable);
-        assert!(s.findings.iter().any(|f| f.message.contains("differs from the table rate")));
+        assert!(
+            s.findings
+                .iter()
+                .any(|f| f.message.contains("differs from the table rate"))
+        );
     }
 
     #[test]

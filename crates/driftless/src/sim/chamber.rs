@@ -1096,7 +1096,10 @@ mod tests {
         assert_eq!(m.segments[1].kind, SegmentKind::Soak);
         // Tilted mid-prefix: no body axis within 20° of the vertical.
         let f = p.trajectory.point(15.0).c_bn.t().mul_vec([0.0, 0.0, -1.0]);
-        assert!(f.iter().all(|v| v.abs() < 20f64.to_radians().cos()), "{f:?}");
+        assert!(
+            f.iter().all(|v| v.abs() < 20f64.to_radians().cos()),
+            "{f:?}"
+        );
         assert_eq!(p.trajectory.point(29.0).c_bn, Mat3::IDENTITY);
         let dwell: Vec<f64> = m
             .segments
@@ -1105,7 +1108,10 @@ mod tests {
             .map(|s| s.duration_s())
             .collect();
         assert_eq!(dwell.len(), 11);
-        assert!(dwell.iter().all(|d| (2.1 - 1e-9..=3.9 + 1e-9).contains(d)), "{dwell:?}");
+        assert!(
+            dwell.iter().all(|d| (2.1 - 1e-9..=3.9 + 1e-9).contains(d)),
+            "{dwell:?}"
+        );
         let spread = dwell.iter().fold(0.0f64, |a, &b| a.max(b))
             - dwell.iter().fold(f64::INFINITY, |a, &b| a.min(b));
         assert!(spread > 0.3, "{dwell:?}");
@@ -1115,7 +1121,12 @@ mod tests {
             .filter(|s| s.kind == SegmentKind::Soak)
             .map(|s| s.duration_s())
             .collect();
-        assert!(soaks.iter().all(|d| (14.0 - 1e-9..=26.0 + 1e-9).contains(d)), "{soaks:?}");
+        assert!(
+            soaks
+                .iter()
+                .all(|d| (14.0 - 1e-9..=26.0 + 1e-9).contains(d)),
+            "{soaks:?}"
+        );
         assert!(soaks.iter().any(|&d| (d - 20.0).abs() > 1e-6), "{soaks:?}");
         assert!(m.position(0.0, plus_x).is_none());
         assert!(m.position(-5.0, plus_x).is_some());
