@@ -125,10 +125,9 @@ fn six_position_z(p: &ChamberProtocol, out: &SensorOutput, seg: &Segmentation) -
         let (sb, sm) = (a.bias_sigma(), a.matrix_sigma());
         for i in 0..3 {
             worst = worst.max((a.calibration.bias[i] - b.calibration.bias[i]).abs() / sb[i]);
-            for j in 0..3 {
-                worst = worst.max(
-                    (a.calibration.matrix.0[i][j] - b.calibration.matrix.0[i][j]).abs() / sm[i][j],
-                );
+            for (j, s) in sm[i].iter().enumerate() {
+                worst = worst
+                    .max((a.calibration.matrix.0[i][j] - b.calibration.matrix.0[i][j]).abs() / s);
             }
         }
     }

@@ -1186,13 +1186,11 @@ impl Segmentation {
         plateaus: &[usize],
         site: &SiteConstants,
     ) -> Result<ChamberManifest, SegmentError> {
-        if !(site.latitude_deg.is_finite() && site.latitude_deg.abs() < 90.0)
-            || !site.longitude_deg.is_finite()
-            || !site.height_m.is_finite()
-            || site
-                .gravity_m_s2
-                .is_some_and(|g| !(g.is_finite() && (9.7..=9.9).contains(&g)))
-        {
+        let site_ok = site.latitude_deg.abs() < 90.0
+            && site.longitude_deg.is_finite()
+            && site.height_m.is_finite()
+            && site.gravity_m_s2.is_none_or(|g| (9.7..=9.9).contains(&g));
+        if !site_ok {
             return Err(SegmentError::BadInput(format!(
                 "site {site:?}: latitude within ±90°, finite longitude and height, gravity \
                  9.7–9.9 m/s²"
