@@ -34,7 +34,8 @@ pub enum Method {
     /// log starts at rest, then many static orientations with rotations in between.
     MultiPosition(MultiArgs),
     /// Six-position + rate-table calibration from a log and its segment manifest (the
-    /// `manifest.toml` of a chamber protocol: positions and ±ω segments).
+    /// `manifest.toml` of a chamber protocol: positions and ±ω segments), or without a
+    /// manifest from the positions and rotations found in the log itself.
     SixPosition(SixArgs),
 }
 
@@ -94,12 +95,16 @@ pub struct SixArgs {
     /// simulate`; channels by quantity or name), sample k at k/rate from the protocol
     /// start.
     pub log: PathBuf,
-    /// Segment manifest (TOML) naming each static position and rate-table segment.
+    /// Segment manifest (TOML) naming each static position and rate-table segment
+    /// (default: segment the log from its data and print the segmentation).
     #[arg(long)]
-    pub manifest: PathBuf,
-    /// Set temperature to use when the manifest has several, °C.
+    pub manifest: Option<PathBuf>,
+    /// Set temperature to use when the manifest (or the log's temperature plateaus) has
+    /// several, °C.
     #[arg(long, allow_hyphen_values = true)]
     pub temperature_c: Option<f64>,
+    #[command(flatten)]
+    pub segment: crate::segment_view::SegmentArgs,
     /// Also estimate the gyro g-sensitivity (3 × 3, raw per m/s²) from the positions.
     #[arg(long)]
     pub g_sensitivity: bool,
@@ -389,14 +394,60 @@ fn multi(m: MultiArgs) -> Result<()> {
         (["#", "interval [s]", "pose", "|a| − g [m/s²]"], residuals),
         &quality,
         serde_json::json!({ "gyro_scale_estimate": scale_json, "accepted_poor_fit": !implausible.is_empty() }),
+        None,
     )
 }
 
 fn six(s: SixArgs) -> Result<()> {
-    let text = std::fs::read_to_string(&s.manifest)
-        .with_context(|| format!("reading {}", s.manifest.display()))?;
-    let manifest = ChamberManifest::from_toml_str(&text)
-        .with_context(|| format!("{}", s.manifest.display()))?;
+    let log = read(&s.common.input, &s.log)?;
+    let (manifest, temp, source, segmentation) = match &s.manifest {
+        Some(path) => {
+            let (m, t) = six_manifest(&s, path)?;
+            (
+                m,
+                t,
+                format!("{} + {}", s.log.display(), path.display()),
+                None,
+            )
+        }
+        None => six_segmented(&s, &log)?,
+    };
+    six_calibrate(&s, &log, &manifest, temp, source, segmentation)
+}
+
+/// Without `--manifest`: the log's own segmentation (printed unless `--json`).
+fn six_segmented(
+    s: &SixArgs,
+    log: &ImuLog,
+) -> Result<(ChamberManifest, f64, String, Option<serde_json::Value>)> {
+    let site = driftless::calib::segment::SiteConstants {
+        latitude_deg: s.common.lat_deg,
+        longitude_deg: 0.0,
+        height_m: s.common.height_m,
+        gravity_m_s2: s.common.gravity,
+    };
+    let (d, temp) = crate::segment_view::six_position_from_log(
+        log,
+        &s.log,
+        &s.segment,
+        s.temperature_c,
+        &site,
+        s.common.json,
+    )?;
+    Ok((
+        d.manifest,
+        temp,
+        format!("{} (segmented from the data)", s.log.display()),
+        Some(d.json),
+    ))
+}
+
+/// The manifest of `--manifest` and the set temperature to calibrate.
+fn six_manifest(s: &SixArgs, path: &Path) -> Result<(ChamberManifest, f64)> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let manifest =
+        ChamberManifest::from_toml_str(&text).with_context(|| format!("{}", path.display()))?;
     let mut temps: Vec<f64> = manifest
         .segments
         .iter()
@@ -410,11 +461,21 @@ fn six(s: SixArgs) -> Result<()> {
         (None, [t]) => *t,
         (None, _) => bail!(
             "{}: {} set temperatures ({temps:?}); choose one with --temperature-c",
-            s.manifest.display(),
+            path.display(),
             temps.len()
         ),
     };
-    let log = read(&s.common.input, &s.log)?;
+    Ok((manifest, temp))
+}
+
+fn six_calibrate(
+    s: &SixArgs,
+    log: &ImuLog,
+    manifest: &ChamberManifest,
+    temp: f64,
+    source: String,
+    segmentation: Option<serde_json::Value>,
+) -> Result<()> {
     let rate = 1.0 / log.tau0_s;
     if (rate - manifest.sample_rate_hz).abs() > 1e-6 * rate {
         bail!(
@@ -423,10 +484,10 @@ fn six(s: SixArgs) -> Result<()> {
             manifest.sample_rate_hz
         );
     }
-    let gyro = triad_columns(&log, Quantity::AngularRate, 0, "gyro")?;
-    let accel = triad_columns(&log, Quantity::SpecificForce, 3, "accelerometer")?;
-    let input = SixPositionInput::from_manifest_columns(&manifest, accel, gyro, 1.0, temp)?;
-    let mut opts = SixPositionOptions::from_manifest(&manifest);
+    let gyro = triad_columns(log, Quantity::AngularRate, 0, "gyro")?;
+    let accel = triad_columns(log, Quantity::SpecificForce, 3, "accelerometer")?;
+    let input = SixPositionInput::from_manifest_columns(manifest, accel, gyro, 1.0, temp)?;
+    let mut opts = SixPositionOptions::from_manifest(manifest);
     opts.estimate_g_sensitivity = s.g_sensitivity;
     if s.common.gravity.is_some() {
         opts.gravity_m_s2 = gravity(&s.common)?;
@@ -439,20 +500,20 @@ fn six(s: SixArgs) -> Result<()> {
     let file = CalibrationFile {
         format_version: FORMAT_VERSION,
         method: "six-position".into(),
-        source: format!("{} + {}", s.log.display(), s.manifest.display()),
+        source,
         gravity_m_s2: opts.gravity_m_s2,
         accel: entry(
             &res.accel.calibration,
             res.accel.bias_sigma(),
             res.accel.matrix_sigma(),
-            &raw_unit(&log, Quantity::SpecificForce),
+            &raw_unit(log, Quantity::SpecificForce),
             None,
         ),
         gyro: entry(
             &res.gyro.calibration,
             res.gyro.bias_sigma(),
             res.gyro.matrix_sigma(),
-            &raw_unit(&log, Quantity::AngularRate),
+            &raw_unit(log, Quantity::AngularRate),
             None,
         ),
         static_intervals: Vec::new(),
@@ -525,6 +586,7 @@ fn six(s: SixArgs) -> Result<()> {
         ),
         &[("accelerometer", &accel_quality), ("gyro", &gyro_quality)],
         serde_json::json!({}),
+        segmentation,
     )
 }
 
@@ -556,6 +618,7 @@ fn output(
     residuals: ([&str; 4], Vec<Vec<String>>),
     quality: &[(&str, &FitQuality)],
     extra: serde_json::Value,
+    segmentation: Option<serde_json::Value>,
 ) -> Result<()> {
     if let Some(p) = &c.out {
         file.save(p)?;
@@ -575,6 +638,8 @@ fn output(
             "gyro_g_sensitivity": file.gyro_g_sensitivity,
             "summary": summary.iter().map(|(k, v)| (k.to_string(), v.clone())).collect::<std::collections::BTreeMap<_, _>>(),
             "seconds": secs,
+            // the log's own segmentation when there was no manifest
+            "segmentation": segmentation,
         });
         if let (Some(obj), serde_json::Value::Object(more)) = (v.as_object_mut(), extra) {
             obj.extend(more);

@@ -1,6 +1,7 @@
-//! `driftless thermal soak LOG --manifest M`: the soak method (issue 6, in progress) —
+//! `driftless thermal soak LOG [--manifest M]`: the soak method (issue 6, in progress) —
 //! six-position + rate-table calibration at every set temperature of a chamber
-//! recording, polynomial fits of each bias and scale series, the real-time compensation
+//! recording (the temperature steps from the manifest, or without one from the log's own
+//! segmentation), polynomial fits of each bias and scale series, the real-time compensation
 //! model file (`--out`) and the bias/scale-versus-temperature figure (`--plot`).
 //! `driftless thermal ramp LOG [--out MODEL.toml]`: the ramp method, optionally as a
 //! bias-only model file. `driftless thermal export MODEL.toml --px4 F.params
@@ -122,9 +123,22 @@ pub struct SoakArgs {
     /// IMU log: time + gyro x, y, z + accel x, y, z (+ temperature), sample k at k/rate
     /// from the protocol start (the `imu.csv` of a `driftless simulate` chamber run).
     pub log: PathBuf,
-    /// Segment manifest (TOML): positions and rate segments per set temperature.
+    /// Segment manifest (TOML): positions and rate segments per set temperature
+    /// (default: segment the log from its data — static positions, rotations and
+    /// temperature plateaus — and print the segmentation; needs --lat-deg, --height-m).
     #[arg(long)]
-    pub manifest: PathBuf,
+    pub manifest: Option<PathBuf>,
+    /// Without a manifest: site latitude, deg (normal gravity and the Earth rate).
+    #[arg(long, allow_hyphen_values = true)]
+    pub lat_deg: Option<f64>,
+    /// Without a manifest: site ellipsoidal height, m.
+    #[arg(long, allow_hyphen_values = true)]
+    pub height_m: Option<f64>,
+    /// Without a manifest: gravity magnitude, m/s² (default: normal gravity at the site).
+    #[arg(long, value_name = "M_S2")]
+    pub gravity: Option<f64>,
+    #[command(flatten)]
+    pub segment: crate::segment_view::SegmentArgs,
     /// Polynomial order, 1–5.
     #[arg(long, default_value_t = 3)]
     pub order: usize,
@@ -346,7 +360,7 @@ fn soak_precheck(
     log: &ImuLog,
     path: &std::path::Path,
     manifest: &ChamberManifest,
-    manifest_path: &std::path::Path,
+    manifest_source: &str,
     order: usize,
     min_rise_c: f64,
 ) -> Result<()> {
@@ -361,7 +375,7 @@ fn soak_precheck(
         anyhow::bail!(
             "{}: set temperatures span {lo}–{hi} °C ({:.1} °C); a thermal model needs at \
              least {min_rise_c} °C (add set points, or lower --min-rise)",
-            manifest_path.display(),
+            manifest_source,
             hi - lo
         );
     }
@@ -388,13 +402,10 @@ fn soak(s: SoakArgs) -> Result<()> {
         "error" => OutOfRange::Error,
         other => anyhow::bail!("--out-of-range {other:?}: expected clamp, extrapolate or error"),
     };
-    let text = std::fs::read_to_string(&s.manifest)
-        .with_context(|| format!("reading {}", s.manifest.display()))?;
-    let manifest = ChamberManifest::from_toml_str(&text)
-        .with_context(|| format!("{}", s.manifest.display()))?;
     let mut input = s.input.clone();
     input.time_column.get_or_insert_with(|| "1".into());
     let log = input.read(&s.log)?;
+    let (manifest, segmentation) = soak_manifest(&s, &log)?;
     let pick = |q: Quantity, what: &str| -> Result<[&[f64]; 3]> {
         log.triad_of(q).ok_or_else(|| {
             anyhow::anyhow!(
@@ -406,7 +417,11 @@ fn soak(s: SoakArgs) -> Result<()> {
     };
     let gyro = pick(Quantity::AngularRate, "angular-rate")?;
     let accel = pick(Quantity::SpecificForce, "specific-force")?;
-    soak_precheck(&log, &s.log, &manifest, &s.manifest, s.order, s.min_rise)?;
+    let manifest_source = match &s.manifest {
+        Some(p) => p.display().to_string(),
+        None => format!("{} (plateaus found in the log)", s.log.display()),
+    };
+    soak_precheck(&log, &s.log, &manifest, &manifest_source, s.order, s.min_rise)?;
     let fit_opts = FitOptions {
         order: s.order,
         t_ref_c: s.t_ref,
@@ -492,6 +507,8 @@ fn soak(s: SoakArgs) -> Result<()> {
                 // not estimated
                 "gyro_g_sensitivity": g_steps,
                 "gyro_g_sensitivity_mean": g_mean,
+                // the log's own segmentation when there was no manifest
+                "segmentation": segmentation,
                 "seconds": secs,
             }))?
         );
@@ -551,6 +568,24 @@ fn soak(s: SoakArgs) -> Result<()> {
         println!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// The manifest of `--manifest`, or without one the log's own segmentation (printed
+/// unless `--json`) with its JSON.
+fn soak_manifest(
+    s: &SoakArgs,
+    log: &driftless::io::ImuLog,
+) -> Result<(ChamberManifest, Option<serde_json::Value>)> {
+    if let Some(path) = &s.manifest {
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        let manifest =
+            ChamberManifest::from_toml_str(&text).with_context(|| format!("{}", path.display()))?;
+        return Ok((manifest, None));
+    }
+    let site = crate::segment_view::site(s.lat_deg, s.height_m, s.gravity, &s.log)?;
+    let d = crate::segment_view::soak_from_log(log, &s.log, &s.segment, &site, s.json)?;
+    Ok((d.manifest, Some(d.json)))
 }
 
 fn ramp(r: RampArgs) -> Result<()> {

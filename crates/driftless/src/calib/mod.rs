@@ -10,6 +10,8 @@
 //! * [`multi_position`]: multi-position accelerometer and gyro calibration without
 //!   fixtures (Tedaldi et al. 2014).
 //! * [`quality`]: χ²/dof, warnings and the plausibility verdict of a fit.
+//! * [`segment`]: segmentation of a calibration log from its data (static positions,
+//!   rotations, temperature plateaus) into a segment manifest.
 //! * [`six_position`]: six-position accelerometer and rate-table gyro calibration with
 //!   covariances (Titterton & Weston §8; IEEE Std 1293).
 
@@ -17,5 +19,6 @@ pub mod lsq;
 pub mod model_file;
 pub mod multi_position;
 pub mod quality;
+pub mod segment;
 pub mod six_position;
 pub mod static_detect;

@@ -157,6 +157,33 @@ pub struct ChamberConfig {
     pub longitude_deg: f64,
     /// Site ellipsoidal height, m (default 1100).
     pub height_m: f64,
+    /// A prefix before the first step, s (default 0: the log starts at the first soak):
+    /// static at home for a third, a move to an attitude with no body axis vertical
+    /// (35° about body x from home), static there, a move back, static at home for the
+    /// rest — the handling a real session records before its protocol starts. One
+    /// `move` segment of the manifest, at the first set temperature.
+    pub prefix_s: f64,
+    /// Relative jitter of every soak and position dwell (default 0): each is multiplied
+    /// by 1 + j·u, u uniform on [−1, 1) drawn from `jitter_seed` (uneven dwells of a
+    /// hand-run session). Moves and rate segments keep their lengths.
+    pub dwell_jitter: f64,
+    /// Seed of the dwell jitter (default 0).
+    pub jitter_seed: u64,
+    /// Positions left out (default none): every visit of `up` in the steps at
+    /// `set_temperature_c` is skipped with the move to it — a position missed in a
+    /// session. The manifest then lacks it too.
+    pub skip_positions: Vec<SkippedPosition>,
+}
+
+/// A static position left out of the steps at one set temperature
+/// ([`ChamberConfig::skip_positions`]). TOML: `{ set_temperature_c = 10.0, up = "+x" }`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SkippedPosition {
+    /// Set temperature of the step(s), °C.
+    pub set_temperature_c: f64,
+    /// The position (axis up) left out.
+    pub up: SignedAxis,
 }
 
 impl Default for ChamberConfig {
@@ -178,6 +205,10 @@ impl Default for ChamberConfig {
             latitude_deg: 51.08,
             longitude_deg: -114.13,
             height_m: 1100.0,
+            prefix_s: 0.0,
+            dwell_jitter: 0.0,
+            jitter_seed: 0,
+            skip_positions: Vec::new(),
         }
     }
 }
@@ -477,11 +508,48 @@ impl ChamberConfig {
                 prev = t;
             }
         }
+        if !(self.prefix_s.is_finite() && self.prefix_s >= 0.0) {
+            return Err(SensorSimError::invalid(
+                format!("chamber.prefix_s = {}", self.prefix_s),
+                "must be finite and ≥ 0",
+            ));
+        }
+        if self.prefix_s > 0.0 && self.prefix_s < 2.0 * self.move_s + 3.0 / self.sample_rate_hz {
+            return Err(SensorSimError::invalid(
+                format!("chamber.prefix_s = {}", self.prefix_s),
+                format!(
+                    "too short for its two moves of move_s = {} s and three holds (0, or at \
+                     least {} s)",
+                    self.move_s,
+                    2.0 * self.move_s + 3.0 / self.sample_rate_hz
+                ),
+            ));
+        }
+        if !(self.dwell_jitter.is_finite() && (0.0..0.9).contains(&self.dwell_jitter)) {
+            return Err(SensorSimError::invalid(
+                format!("chamber.dwell_jitter = {}", self.dwell_jitter),
+                "must be a fraction in [0, 0.9)",
+            ));
+        }
+        for (i, sp) in self.skip_positions.iter().enumerate() {
+            if !self.temperatures_c.contains(&sp.set_temperature_c) {
+                return Err(SensorSimError::invalid(
+                    format!(
+                        "chamber.skip_positions[{i}].set_temperature_c = {}",
+                        sp.set_temperature_c
+                    ),
+                    format!("not one of temperatures_c {:?}", self.temperatures_c),
+                ));
+            }
+        }
         // Every duration must be at least one sample.
-        let dwell = self.visit_dwell_s();
+        let dwell = self.visit_dwell_s() * (1.0 - self.dwell_jitter);
         for (name, d) in [
             ("soak_s", self.soak_s),
-            ("first_soak_s", self.first_soak_s.unwrap_or(self.soak_s)),
+            (
+                "first_soak_s",
+                self.first_soak_s.unwrap_or(self.soak_s) * (1.0 - self.dwell_jitter),
+            ),
             ("position_dwell_s", dwell),
             ("move_s", self.move_s),
             ("spin_s", self.spin_s),
@@ -544,20 +612,57 @@ impl ChamberConfig {
             segments: Vec::new(),
         };
         let mut steps = Vec::with_capacity(self.temperatures_c.len());
+        let mut jitter_rng = super::rng::Rng::stream(self.jitter_seed, 0);
+        let mut jitter = |d: f64| -> f64 {
+            if self.dwell_jitter > 0.0 {
+                d * (1.0 + self.dwell_jitter * jitter_rng.uniform_pm1())
+            } else {
+                d
+            }
+        };
+        let mut prefix_n = 0;
+        if self.prefix_s > 0.0 {
+            // Home, tilted 35° about body x (no axis vertical), home again: one move.
+            let n_total = ns(self.prefix_s);
+            let n_move = ns(self.move_s);
+            let n_hold = (n_total - 2 * n_move) / 3;
+            let tilt = rotate(home, [1.0, 0.0, 0.0], 35.0 * DEG);
+            b.hold(n_hold.max(1), SegmentKind::Move);
+            b.move_to(n_move, tilt);
+            b.hold(n_hold.max(1), SegmentKind::Move);
+            b.move_to(n_move, home);
+            b.hold(
+                (n_total - 2 * n_move).saturating_sub(2 * n_hold).max(1),
+                SegmentKind::Move,
+            );
+            prefix_n = b.k;
+        }
         for (i, &set_c) in self.temperatures_c.iter().enumerate() {
-            let k_start = b.k;
+            let k_start = if i == 0 { b.k - prefix_n } else { b.k };
             b.set_c = set_c;
             b.move_to(ns(self.move_s), home);
             let soak_s = match self.first_soak_s {
                 Some(d) if i == 0 => d,
                 _ => self.soak_s,
             };
-            b.hold(ns(soak_s), SegmentKind::Soak);
+            b.hold(ns(jitter(soak_s)), SegmentKind::Soak);
             // A position repeated back to back (the middle of the palindrome) needs no
             // move: `move_to` skips it.
             for &up in &positions {
+                if self
+                    .skip_positions
+                    .iter()
+                    .any(|sp| sp.set_temperature_c == set_c && sp.up == up)
+                {
+                    continue;
+                }
                 b.move_to(ns(self.move_s), up.c_bn_up());
-                b.hold(n_dwell, SegmentKind::Position { up });
+                let n = if self.dwell_jitter > 0.0 {
+                    ns(jitter(self.visit_dwell_s()))
+                } else {
+                    n_dwell
+                };
+                b.hold(n, SegmentKind::Position { up });
             }
             for axis in BodyAxis::ALL {
                 let at = SignedAxis::new(axis, true).c_bn_up();
@@ -966,6 +1071,103 @@ mod tests {
             );
             assert_eq!(toml::from_str::<ChamberConfig>(&text).unwrap(), cfg);
         }
+    }
+
+    /// The session variants: a prefix (one move segment, tilted in its middle), jittered
+    /// dwells and a skipped position, with the attitude still continuous and the TOML
+    /// keys round-tripping.
+    #[test]
+    fn prefix_jitter_and_skipped_positions() {
+        let plus_x = SignedAxis::new(BodyAxis::X, true);
+        let cfg = ChamberConfig {
+            prefix_s: 30.0,
+            dwell_jitter: 0.3,
+            jitter_seed: 5,
+            skip_positions: vec![SkippedPosition {
+                set_temperature_c: 0.0,
+                up: plus_x,
+            }],
+            ..small()
+        };
+        let p = cfg.build().unwrap();
+        let m = &p.manifest;
+        assert_eq!(m.segments[0].kind, SegmentKind::Move);
+        assert!((m.segments[0].duration_s() - 30.0).abs() < 1e-9);
+        assert_eq!(m.segments[1].kind, SegmentKind::Soak);
+        // Tilted mid-prefix: no body axis within 20° of the vertical.
+        let f = p.trajectory.point(15.0).c_bn.t().mul_vec([0.0, 0.0, -1.0]);
+        assert!(
+            f.iter().all(|v| v.abs() < 20f64.to_radians().cos()),
+            "{f:?}"
+        );
+        assert_eq!(p.trajectory.point(29.0).c_bn, Mat3::IDENTITY);
+        let dwell: Vec<f64> = m
+            .segments
+            .iter()
+            .filter(|s| matches!(s.kind, SegmentKind::Position { .. }))
+            .map(|s| s.duration_s())
+            .collect();
+        assert_eq!(dwell.len(), 11);
+        assert!(
+            dwell.iter().all(|d| (2.1 - 1e-9..=3.9 + 1e-9).contains(d)),
+            "{dwell:?}"
+        );
+        let spread = dwell.iter().fold(0.0f64, |a, &b| a.max(b))
+            - dwell.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+        assert!(spread > 0.3, "{dwell:?}");
+        let soaks: Vec<f64> = m
+            .segments
+            .iter()
+            .filter(|s| s.kind == SegmentKind::Soak)
+            .map(|s| s.duration_s())
+            .collect();
+        assert!(
+            soaks
+                .iter()
+                .all(|d| (14.0 - 1e-9..=26.0 + 1e-9).contains(d)),
+            "{soaks:?}"
+        );
+        assert!(soaks.iter().any(|&d| (d - 20.0).abs() > 1e-6), "{soaks:?}");
+        assert!(m.position(0.0, plus_x).is_none());
+        assert!(m.position(-5.0, plus_x).is_some());
+        assert_eq!(m.steps().len(), 2);
+        let TemperatureProfile::Chamber { steps, .. } = &p.temperature else {
+            panic!()
+        };
+        let total: f64 = steps.iter().map(|s| s.duration_s).sum();
+        assert!((total - m.duration_s).abs() < 1e-9);
+        for w in p.trajectory.pieces.windows(2) {
+            let (a, wa) = w[0].attitude(w[0].duration_s);
+            let (b, wb) = w[1].attitude(0.0);
+            for r in 0..3 {
+                for c in 0..3 {
+                    assert!((a.0[r][c] - b.0[r][c]).abs() < 1e-12);
+                }
+                assert!((wa[r] - wb[r]).abs() < 1e-12);
+            }
+        }
+        let text = toml::to_string(&cfg).unwrap();
+        assert!(text.contains("up = \"+x\""), "{text}");
+        assert_eq!(toml::from_str::<ChamberConfig>(&text).unwrap(), cfg);
+        let bad = |c: ChamberConfig| c.build().unwrap_err().to_string();
+        let e = bad(ChamberConfig {
+            skip_positions: vec![SkippedPosition {
+                set_temperature_c: 7.0,
+                up: plus_x,
+            }],
+            ..small()
+        });
+        assert!(e.contains("skip_positions[0].set_temperature_c = 7"), "{e}");
+        let e = bad(ChamberConfig {
+            dwell_jitter: 0.95,
+            ..small()
+        });
+        assert!(e.contains("dwell_jitter = 0.95"), "{e}");
+        let e = bad(ChamberConfig {
+            prefix_s: 3.0,
+            ..small()
+        });
+        assert!(e.contains("prefix_s = 3") && e.contains("too short"), "{e}");
     }
 
     #[test]

@@ -55,7 +55,9 @@ impl BodyAxis {
 }
 
 /// A signed body axis, written `+x` … `-z`; in a position it is the axis pointing up.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// Serialises as that string.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
 pub struct SignedAxis {
     /// The axis.
     pub axis: BodyAxis,
@@ -108,6 +110,19 @@ impl fmt::Display for SignedAxis {
             if self.positive { '+' } else { '-' },
             self.axis.letter()
         )
+    }
+}
+
+impl From<SignedAxis> for String {
+    fn from(s: SignedAxis) -> String {
+        s.to_string()
+    }
+}
+
+impl TryFrom<String> for SignedAxis {
+    type Error = String;
+    fn try_from(s: String) -> Result<SignedAxis, String> {
+        s.parse()
     }
 }
 
