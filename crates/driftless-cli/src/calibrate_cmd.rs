@@ -394,7 +394,6 @@ fn multi(m: MultiArgs) -> Result<()> {
         (["#", "interval [s]", "pose", "|a| − g [m/s²]"], residuals),
         &quality,
         serde_json::json!({ "gyro_scale_estimate": scale_json, "accepted_poor_fit": !implausible.is_empty() }),
-        None,
     )
 }
 
@@ -585,8 +584,8 @@ fn six_calibrate(
             residuals,
         ),
         &[("accelerometer", &accel_quality), ("gyro", &gyro_quality)],
-        serde_json::json!({}),
-        segmentation,
+        // the log's own segmentation when there was no manifest
+        serde_json::json!({ "segmentation": segmentation }),
     )
 }
 
@@ -618,7 +617,6 @@ fn output(
     residuals: ([&str; 4], Vec<Vec<String>>),
     quality: &[(&str, &FitQuality)],
     extra: serde_json::Value,
-    segmentation: Option<serde_json::Value>,
 ) -> Result<()> {
     if let Some(p) = &c.out {
         file.save(p)?;
@@ -638,8 +636,6 @@ fn output(
             "gyro_g_sensitivity": file.gyro_g_sensitivity,
             "summary": summary.iter().map(|(k, v)| (k.to_string(), v.clone())).collect::<std::collections::BTreeMap<_, _>>(),
             "seconds": secs,
-            // the log's own segmentation when there was no manifest
-            "segmentation": segmentation,
         });
         if let (Some(obj), serde_json::Value::Object(more)) = (v.as_object_mut(), extra) {
             obj.extend(more);

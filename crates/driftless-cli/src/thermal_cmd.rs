@@ -421,7 +421,14 @@ fn soak(s: SoakArgs) -> Result<()> {
         Some(p) => p.display().to_string(),
         None => format!("{} (plateaus found in the log)", s.log.display()),
     };
-    soak_precheck(&log, &s.log, &manifest, &manifest_source, s.order, s.min_rise)?;
+    soak_precheck(
+        &log,
+        &s.log,
+        &manifest,
+        &manifest_source,
+        s.order,
+        s.min_rise,
+    )?;
     let fit_opts = FitOptions {
         order: s.order,
         t_ref_c: s.t_ref,
