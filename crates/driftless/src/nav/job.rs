@@ -297,7 +297,10 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
                     ));
                 }
             }
-            Some(f.calibration())
+            Some((
+                f.calibration(),
+                f.gyro_g_sensitivity.map(driftless_model::linalg::Mat3),
+            ))
         }
         None => None,
     };
@@ -361,8 +364,8 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
             ));
         }
     }
-    if let Some(cal) = &calibration {
-        imu.apply_calibration(cal);
+    if let Some((cal, g)) = &calibration {
+        imu.apply_calibration(cal, g.as_ref());
     }
     let gnss = read_gnss_file(&gnss_path, &GnssReadOptions::default())?;
     notes.extend(gnss.notes.iter().cloned());

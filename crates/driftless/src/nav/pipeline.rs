@@ -364,19 +364,27 @@ impl ImuStream {
     }
 
     /// Applies a room-temperature calibration whose raw units are SI (rad/s, m/s²) to
-    /// the increments: Δθ' = M_g(Δθ − b_g·Δt), Δv' = M_a(Δv − b_a·Δt) — the rate model
-    /// calibrated = M·(raw − b) integrated over each interval (exact for constant M, b).
-    pub fn apply_calibration(&mut self, cal: &driftless_model::calib::ImuCalibration) {
+    /// the increments: Δv' = M_a(Δv − b_a·Δt), Δθ' = M_g(Δθ − b_g·Δt − G·Δv') — the rate
+    /// model f = M_a(f̃ − b_a), ω = M_g(ω̃ − b_g − G f) with the gyro g-sensitivity G
+    /// (rad/s per m/s², raw = … + G·f, as six-position calibration estimates it; none when
+    /// `gyro_g_sensitivity` is `None`) integrated over each interval (exact for constant
+    /// M, b, G).
+    pub fn apply_calibration(
+        &mut self,
+        cal: &driftless_model::calib::ImuCalibration,
+        gyro_g_sensitivity: Option<&driftless_model::linalg::Mat3>,
+    ) {
         use driftless_model::linalg::{scale, sub};
         for e in &mut self.epochs {
-            e.dtheta_rad = cal
-                .gyro
-                .matrix
-                .mul_vec(sub(e.dtheta_rad, scale(cal.gyro.bias, e.dt_s)));
             e.dvel_m_s = cal
                 .accel
                 .matrix
                 .mul_vec(sub(e.dvel_m_s, scale(cal.accel.bias, e.dt_s)));
+            let mut dtheta = sub(e.dtheta_rad, scale(cal.gyro.bias, e.dt_s));
+            if let Some(g) = gyro_g_sensitivity {
+                dtheta = sub(dtheta, g.mul_vec(e.dvel_m_s));
+            }
+            e.dtheta_rad = cal.gyro.matrix.mul_vec(dtheta);
         }
     }
 }
@@ -1055,12 +1063,31 @@ mod tests {
                 matrix: m,
             },
         };
-        s.apply_calibration(&cal);
+        let mut with_g = s.clone();
+        s.apply_calibration(&cal, None);
         let w = cal.gyro.apply([0.02, -0.01, 0.5]);
         let f = cal.accel.apply([0.3, 0.1, -9.8]);
         for k in 0..3 {
             assert!((s.epochs[0].dtheta_rad[k] - w[k] * dt).abs() < 1e-15);
             assert!((s.epochs[0].dvel_m_s[k] - f[k] * dt).abs() < 1e-14);
+        }
+        // g-sensitivity: ω = M_g(ω̃ − b_g − G f) with f the calibrated specific force.
+        let g = Mat3([
+            [2e-4, -1e-4, 3e-4],
+            [0.0, 1.5e-4, -2e-4],
+            [1e-4, 0.0, 2.5e-4],
+        ]);
+        with_g.apply_calibration(&cal, Some(&g));
+        let gf = g.mul_vec(f);
+        let raw = [0.02 - gf[0], -0.01 - gf[1], 0.5 - gf[2]];
+        let w_g = cal.gyro.apply(raw);
+        for k in 0..3 {
+            assert!((with_g.epochs[0].dtheta_rad[k] - w_g[k] * dt).abs() < 1e-15);
+            assert!(
+                (w_g[k] - w[k]).abs() > 1e-4,
+                "G changed nothing on axis {k}"
+            );
+            assert!((with_g.epochs[0].dvel_m_s[k] - f[k] * dt).abs() < 1e-14);
         }
     }
 }
