@@ -103,6 +103,19 @@ fn print_table(seg: &Segmentation, path: &Path) {
     let mut tab =
         crate::output::Table::new(["segment", "start [s]", "end [s]", "what", "up", "plateau"]);
     let plateau = |p: Option<usize>| p.map_or("–".to_string(), |p| p.to_string());
+    let row = |kind: &str, start_s: f64, end_s: f64, what: String, up: String, p| {
+        (
+            start_s,
+            vec![
+                kind.to_string(),
+                format!("{start_s:.2}"),
+                format!("{end_s:.2}"),
+                what,
+                up,
+                plateau(p),
+            ],
+        )
+    };
     let mut rows: Vec<(f64, Vec<String>)> = Vec::new();
     for s in &seg.statics {
         let what = match s.role {
@@ -113,16 +126,14 @@ fn print_table(seg: &Segmentation, path: &Path) {
             },
             StaticRole::Other => format!("static, {:.1}° off an axis", s.tilt_deg),
         };
-        rows.push((
+        let up = s.up.map_or("other".into(), |u| u.to_string());
+        rows.push(row(
+            "static",
             s.span.start_s,
-            vec![
-                "static".into(),
-                format!("{:.2}", s.span.start_s),
-                format!("{:.2}", s.span.end_s),
-                what,
-                s.up.map_or("other".into(), |u| u.to_string()),
-                plateau(s.plateau),
-            ],
+            s.span.end_s,
+            what,
+            up,
+            s.plateau,
         ));
     }
     for r in &seg.rotations {
@@ -135,16 +146,14 @@ fn print_table(seg: &Segmentation, path: &Path) {
             r.revolutions,
             if r.usable { "" } else { ", not used" }
         );
-        rows.push((
+        let up = r.up.map_or("other".into(), |u| u.to_string());
+        rows.push(row(
+            "rotation",
             r.span.start_s,
-            vec![
-                "rotation".into(),
-                format!("{:.2}", r.span.start_s),
-                format!("{:.2}", r.span.end_s),
-                what,
-                r.up.map_or("other".into(), |u| u.to_string()),
-                plateau(r.plateau),
-            ],
+            r.span.end_s,
+            what,
+            up,
+            r.plateau,
         ));
     }
     rows.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -1,4 +1,4 @@
-//! `driftless thermal soak LOG [--manifest M]`: the soak method (issue 6, in progress) —
+//! `driftless thermal soak LOG [--manifest M]`: the soak method —
 //! six-position + rate-table calibration at every set temperature of a chamber
 //! recording (the temperature steps from the manifest, or without one from the log's own
 //! segmentation), polynomial fits of each bias and scale series, the real-time compensation

@@ -348,14 +348,7 @@ fn run(seed: u64, protocol: Protocol) -> Run {
     let mut cfg = Preset::AdiLike.config();
     if !all_terms {
         // deterministic errors, turn-on biases and white noise only (module docs)
-        for n in cfg.gyro.noise.iter_mut().chain(cfg.accel.noise.iter_mut()) {
-            n.bias_instability = 0.0;
-            n.rate_random_walk = 0.0;
-            n.quantization = 0.0;
-            n.gauss_markov = None;
-        }
-        cfg.accel.rate_lsb_m_s2 = 0.0;
-        cfg.gyro.rate_lsb_rad_s = 0.0;
+        cfg = cfg.without_slow_noise();
     }
     let model = SensorModel::new(cfg.clone()).expect("model");
     let curve = proto.temperature.curve().expect("temperature");

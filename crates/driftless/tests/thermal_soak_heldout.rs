@@ -51,14 +51,7 @@ fn simulate(seed: u64, every_noise: bool) -> (ChamberProtocol, SensorOutput, Soa
     .expect("protocol");
     let mut cfg = Preset::AdiLike.config();
     if !every_noise {
-        for n in cfg.gyro.noise.iter_mut().chain(cfg.accel.noise.iter_mut()) {
-            n.bias_instability = 0.0;
-            n.rate_random_walk = 0.0;
-            n.quantization = 0.0;
-            n.gauss_markov = None;
-        }
-        cfg.accel.rate_lsb_m_s2 = 0.0;
-        cfg.gyro.rate_lsb_rad_s = 0.0;
+        cfg = cfg.without_slow_noise();
     }
     let drift = SoakDrift::from_sensor_config(&cfg);
     let curve = proto.temperature.curve().expect("temperature");

@@ -247,6 +247,22 @@ impl SensorConfig {
         c
     }
 
+    /// The same sensor with white noise as its only noise term: bias instability, rate
+    /// random walk, quantization noise, Gauss–Markov terms and output quantization
+    /// removed; turn-on biases and every deterministic term kept.
+    pub fn without_slow_noise(&self) -> SensorConfig {
+        let mut c = self.clone();
+        for n in c.gyro.noise.iter_mut().chain(c.accel.noise.iter_mut()) {
+            n.bias_instability = 0.0;
+            n.rate_random_walk = 0.0;
+            n.quantization = 0.0;
+            n.gauss_markov = None;
+        }
+        c.accel.rate_lsb_m_s2 = 0.0;
+        c.gyro.rate_lsb_rad_s = 0.0;
+        c
+    }
+
     /// The same sensor's stochastic terms only (no biases, scale factors, misalignment,
     /// g-sensitivity, thermal dependence or quantization).
     pub fn noise_only(&self) -> SensorConfig {
