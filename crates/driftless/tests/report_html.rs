@@ -158,15 +158,7 @@ fn thermal_figure() -> Figure {
     }
     .build()
     .expect("protocol");
-    let mut cfg = Preset::AdiLike.config();
-    for n in cfg.gyro.noise.iter_mut().chain(cfg.accel.noise.iter_mut()) {
-        n.bias_instability = 0.0;
-        n.rate_random_walk = 0.0;
-        n.quantization = 0.0;
-        n.gauss_markov = None;
-    }
-    cfg.accel.rate_lsb_m_s2 = 0.0;
-    cfg.gyro.rate_lsb_rad_s = 0.0;
+    let cfg = Preset::AdiLike.config().without_slow_noise();
     let model = SensorModel::new(cfg).expect("sensor model");
     let curve = proto.temperature.curve().expect("temperature");
     let out = model
