@@ -1,6 +1,7 @@
 //! `driftless experiment SCENARIO.toml`: the seed paper's experiment end to end
 //! (`driftless::experiment`) — Allan → noise model, chamber → thermal model, the vehicle
-//! run in cases (a) raw, (b) room calibration, (c) room + thermal, forward and smoothed,
+//! run in cases (a) raw, (b) room biases, (c) room bias, scale factor and thermal model,
+//! (d) full room calibration, forward and smoothed,
 //! GNSS outages, Table 1, figures and one self-contained HTML report. `driftless demo`
 //! runs it on the built-in `adi-like` scenario.
 
@@ -9,7 +10,7 @@ use clap::Args;
 use driftless::experiment::monte_carlo::{ExperimentResult, run_experiment};
 use driftless::experiment::run::Prepared;
 use driftless::experiment::table::{
-    Column, ExperimentDocument, csv, markdown, ratio_explanation, table_rows,
+    Column, ExperimentDocument, csv, markdown, ratio_explanation, reversal_explanation, table_rows,
 };
 use driftless::experiment::{ExperimentScenario, prepare};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -148,6 +149,13 @@ fn print_human(p: &Prepared, r: &ExperimentResult) {
     for line in ratio_explanation(p, r) {
         println!("{line}");
     }
+    let reversals = reversal_explanation(r);
+    if !reversals.is_empty() {
+        println!();
+        for line in reversals {
+            println!("{line}");
+        }
+    }
 }
 
 /// Writes Table 1 (Markdown, CSV), the JSON document and the report; returns the paths.
@@ -176,6 +184,11 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
     }
     md.push_str("## Monte Carlo and the paper's ratio\n\n");
     for line in ratio_explanation(p, r) {
+        md.push_str(&line);
+        md.push_str("\n\n");
+    }
+    md.push_str("## Where more compensation did worse\n\n");
+    for line in reversal_explanation(r) {
         md.push_str(&line);
         md.push_str("\n\n");
     }

@@ -75,7 +75,16 @@ fn printed_builtin_scenario_runs_one_run() {
     );
     assert_eq!(v["outages"].as_array().unwrap().len(), 9);
     let run0 = v["run0"].as_array().unwrap();
-    assert_eq!(run0.len(), 3);
+    assert_eq!(run0.len(), 4);
+    let cases: Vec<&str> = run0.iter().map(|c| c["case"].as_str().unwrap()).collect();
+    assert_eq!(cases, ["raw", "room_bias", "thermal", "room_full"]);
+    // Every case of run 0 carries its per-outage budget; the reversals are listed.
+    assert!(
+        run0.iter()
+            .all(|c| c["budgets"].as_array().unwrap().len() == 9)
+    );
+    assert!(v["run0_reversals"].is_array());
+    assert_eq!(v["monte_carlo"]["reversals"].as_array().unwrap().len(), 6);
     let csv = std::fs::read_to_string(out_dir.join("table1.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 12, "{csv}");
@@ -87,4 +96,5 @@ fn printed_builtin_scenario_runs_one_run() {
     assert!((cell - json).abs() <= 0.5 + 0.01 * json, "{cell} vs {json}");
     let md = std::fs::read_to_string(out_dir.join("table1.md")).unwrap();
     assert!(md.contains("| #9 |") && md.contains("8.4×"), "{md}");
+    assert!(md.contains("## Where more compensation did worse"), "{md}");
 }

@@ -11,11 +11,15 @@
 //! (b)/(c) is the ratio of the two means over runs; its interval is a percentile
 //! bootstrap over runs (the same resampled runs for both cases, so their correlation is
 //! kept; 4000 resamples, fixed seed), which needs no normality of the per-run errors.
+//! (d)/(c) — what the thermal model adds to a full room calibration — is reported the
+//! same way, and so is how often, over every run and outage, a more compensated case
+//! ended worse than a less compensated one ([`super::budget`]).
 
 use rayon::prelude::*;
 use serde::Serialize;
 
 use super::ExperimentError;
+use super::budget::{ReversalCount, reversal_counts};
 use super::run::{
     Case, NoiseStage, Prepared, ThermalStage, VehicleRun, noise_stage, splitmix64, thermal_stage,
     vehicle_run,
@@ -169,10 +173,17 @@ pub struct MonteCarloSummary {
     pub runs: usize,
     /// Per case.
     pub cases: Vec<CaseSpread>,
-    /// (b)/(c) of the forward filter's mean end-of-outage error, when (c) was run.
+    /// (b)/(c) of the forward filter's mean end-of-outage error, when (c) was run: room
+    /// biases only against bias, scale and thermal model (the paper's ratio).
     pub ratio_room_over_thermal: Option<RatioInterval>,
     /// (b)/(c) of the smoothed solution.
     pub ratio_room_over_thermal_smoothed: Option<RatioInterval>,
+    /// (d)/(c), forward: the full room calibration against the same plus the thermal
+    /// model — what the thermal model alone buys.
+    pub ratio_full_room_over_thermal: Option<RatioInterval>,
+    /// Over all runs and outages, how often a more compensated case ended worse than a
+    /// less compensated one.
+    pub reversals: Vec<ReversalCount>,
 }
 
 /// Percentile-bootstrap interval of mean(num)/mean(den) over paired runs.
@@ -264,12 +275,11 @@ pub fn summarise(runs: &[VehicleRun], confidence: f64, seed: u64) -> MonteCarloS
             first_failure: failures.first().map(|s| s.to_string()),
         });
     }
-    let has_c = present.contains(&Case::Thermal);
-    let ratio = |smoothed| {
-        has_c
+    let ratio = |num: Case, smoothed| {
+        (present.contains(&num) && present.contains(&Case::Thermal))
             .then(|| {
                 ratio_interval(
-                    &col(Case::Room, smoothed),
+                    &col(num, smoothed),
                     &col(Case::Thermal, smoothed),
                     confidence,
                     seed,
@@ -280,8 +290,12 @@ pub fn summarise(runs: &[VehicleRun], confidence: f64, seed: u64) -> MonteCarloS
     MonteCarloSummary {
         runs: runs.len(),
         cases,
-        ratio_room_over_thermal: ratio(false),
-        ratio_room_over_thermal_smoothed: all_smoothed.then(|| ratio(true)).flatten(),
+        ratio_room_over_thermal: ratio(Case::RoomBias, false),
+        ratio_room_over_thermal_smoothed: all_smoothed
+            .then(|| ratio(Case::RoomBias, true))
+            .flatten(),
+        ratio_full_room_over_thermal: ratio(Case::RoomFull, false),
+        reversals: reversal_counts(runs),
     }
 }
 

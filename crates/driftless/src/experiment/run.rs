@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::ExperimentError;
+use super::budget::{OutageBudget, outage_budgets};
 use super::scenario::{ExperimentScenario, VehicleSource};
 use crate::allan::analysis::{AnalysisConfig, ChannelResult, analyse_channels};
 use crate::allan::fit::FitConfig;
@@ -39,26 +40,36 @@ use crate::thermal::{FitOptions, model_file::ThermalModelFile};
 use driftless_model::compensation::{CompensationModel, OutOfRange};
 use driftless_model::units::DEG;
 
-/// The three ways the vehicle IMU data are processed.
+/// The ways the vehicle IMU data are processed, from least to most compensated.
+///
+/// (a)–(c) are the paper's three columns; (d) is the full room calibration without the
+/// thermal model, between (b) and (c): (a) ⊂ (b) ⊂ (d) ⊂ (c) in what is corrected.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Case {
     /// (a) the IMU output as logged.
     Raw,
-    /// (b) room-temperature calibration only (bias, scale, misalignment at 25 °C) — the
-    /// paper's "uncompensated"; on recorded data without a calibration, the gyro biases
-    /// of the static start removed.
-    Room,
-    /// (c) room calibration + thermal model at the sensor's temperature reading.
+    /// (b) the biases removed at room temperature — no scale factor, no misalignment, no
+    /// thermal model: ω = ω̃ − b_g(25 °C), f = f̃ − b_a(25 °C). The paper's column 2
+    /// ("without scale factor and thermal compensation models"). On recorded data
+    /// without a calibration, the gyro biases of the static start removed.
+    RoomBias,
+    /// (c) room bias, scale factor and misalignment plus the thermal model at the
+    /// sensor's temperature reading (and the gyro g-sensitivity when the model has it).
     Thermal,
+    /// (d) the full room calibration at 25 °C (bias, scale factor, misalignment), no
+    /// thermal model — what a calibration without a chamber gives.
+    RoomFull,
 }
 
 impl Case {
-    /// The cases an experiment processes: (a), (b), and (c) when there is a thermal model.
+    /// The cases an experiment processes: (a) and (b); (c) and (d) when there is a
+    /// thermal model (its room calibration gives (d)). In table order.
     pub fn processed(with_thermal_model: bool) -> Vec<Case> {
-        let mut c = vec![Case::Raw, Case::Room];
+        let mut c = vec![Case::Raw, Case::RoomBias];
         if with_thermal_model {
             c.push(Case::Thermal);
+            c.push(Case::RoomFull);
         }
         c
     }
@@ -67,8 +78,20 @@ impl Case {
     pub fn label(self) -> &'static str {
         match self {
             Case::Raw => "(a) raw",
-            Case::Room => "(b) room cal",
+            Case::RoomBias => "(b) room biases",
             Case::Thermal => "(c) room + thermal",
+            Case::RoomFull => "(d) full room cal",
+        }
+    }
+
+    /// Rank in what is corrected: (a) 0 < (b) 1 < (d) 2 < (c) 3. A case with a higher
+    /// rank corrects everything a lower one does, and more.
+    pub fn compensation_rank(self) -> u8 {
+        match self {
+            Case::Raw => 0,
+            Case::RoomBias => 1,
+            Case::RoomFull => 2,
+            Case::Thermal => 3,
         }
     }
 }
@@ -620,6 +643,8 @@ pub struct CaseRun {
     pub gnss_rejected: usize,
     /// The forward solution (kept for the detailed run only).
     pub forward_solution: Option<NavSolution>,
+    /// Error budget per outage (detailed run only; [`super::budget`]).
+    pub budgets: Option<Vec<Option<OutageBudget>>>,
 }
 
 impl CaseRun {
@@ -632,6 +657,7 @@ impl CaseRun {
             gnss_accepted: 0,
             gnss_rejected: 0,
             forward_solution: None,
+            budgets: None,
         }
     }
 
@@ -683,6 +709,7 @@ impl VehicleRun {
                     gnss_accepted: c.gnss_accepted,
                     gnss_rejected: c.gnss_rejected,
                     forward_solution: None,
+                    budgets: c.budgets.clone(),
                 })
                 .collect(),
             reference: None,
@@ -697,9 +724,62 @@ impl VehicleRun {
     }
 }
 
+/// Largest departure of a room calibration's matrices from the identity: removing the
+/// biases alone, case (b), is meaningful only for output already in SI units.
+const MAX_BIAS_ONLY_MATRIX_DEPARTURE: f64 = 0.1;
+
+/// Checks that case (b) (biases only) applies to data calibrated by `model`.
+fn check_bias_only(model: &CompensationModel) -> Result<(), String> {
+    let room = model.calibration();
+    for (name, m) in [
+        ("gyro", &room.gyro.matrix),
+        ("accelerometer", &room.accel.matrix),
+    ] {
+        let dev = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .map(|(i, j)| (m.0[i][j] - if i == j { 1.0 } else { 0.0 }).abs())
+            .fold(0.0, f64::max);
+        if dev > MAX_BIAS_ONLY_MATRIX_DEPARTURE {
+            return Err(format!(
+                "the room calibration's {name} matrix departs from the identity by {dev:.3} \
+                 (more than {MAX_BIAS_ONLY_MATRIX_DEPARTURE}): the data are not in SI units, so \
+                 removing only the biases (case b) leaves them unscaled; give data in rad/s and \
+                 m/s² or a model calibrated on them"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// One sample of case `case` from the sensor's output (ω̃ rad/s, f̃ m/s²) at
+/// temperature `t_c` (°C), with the thermal model `model`: (a) as is; (b) ω̃ − b_g,
+/// f̃ − b_a with the room biases; (d) the room calibration M(x̃ − b); (c) the whole
+/// model at `t_c` ([`CompensationModel::compensate`]).
+fn compensate_case(
+    case: Case,
+    model: &CompensationModel,
+    gyro_rad_s: [f64; 3],
+    accel_m_s2: [f64; 3],
+    t_c: f64,
+) -> Result<([f64; 3], [f64; 3]), String> {
+    let room = model.calibration();
+    let minus = |x: [f64; 3], b: [f64; 3]| [x[0] - b[0], x[1] - b[1], x[2] - b[2]];
+    match case {
+        Case::Raw => Ok((gyro_rad_s, accel_m_s2)),
+        Case::RoomBias => Ok((
+            minus(gyro_rad_s, room.gyro.bias),
+            minus(accel_m_s2, room.accel.bias),
+        )),
+        Case::RoomFull => Ok((room.gyro.apply(gyro_rad_s), room.accel.apply(accel_m_s2))),
+        Case::Thermal => model
+            .compensate(gyro_rad_s, accel_m_s2, t_c)
+            .map_err(|e| e.to_string()),
+    }
+}
+
 /// The navigation stream of one case from simulated rates: the increments of
-/// [`SensorOutput::to_increments`] (Δθ = ω·Δt, Δv = f·Δt) of the raw, room-calibrated or
-/// thermally compensated rates.
+/// [`SensorOutput::to_increments`] (Δθ = ω·Δt, Δv = f·Δt) of the rates compensated as
+/// the case says ([`compensate_case`]).
 fn case_stream(
     raw: &SensorOutput,
     case: Case,
@@ -709,17 +789,21 @@ fn case_stream(
         return Err("the simulated vehicle IMU must output rates".into());
     }
     let mut epochs = raw.to_increments();
-    if let (Some(t), Case::Room | Case::Thermal) = (thermal, case) {
-        let room = *t.model.calibration();
+    if let Some(t) = thermal
+        && case != Case::Raw
+    {
+        if case == Case::RoomBias {
+            check_bias_only(&t.model)?;
+        }
         for (k, e) in epochs.iter_mut().enumerate() {
-            let (g, a) = (raw.gyro_at(k), raw.accel_at(k));
-            let (gc, ac) = if case == Case::Room {
-                (room.gyro.apply(g), room.accel.apply(a))
-            } else {
-                t.model
-                    .compensate(g, a, raw.temperature_c[k])
-                    .map_err(|e| format!("sample {k}: {e}"))?
-            };
+            let (gc, ac) = compensate_case(
+                case,
+                &t.model,
+                raw.gyro_at(k),
+                raw.accel_at(k),
+                raw.temperature_c[k],
+            )
+            .map_err(|e| format!("sample {k}: {e}"))?;
             e.dtheta_rad = gc.map(|v| v * raw.dt_s);
             e.dvel_m_s = ac.map(|v| v * raw.dt_s);
         }
@@ -810,6 +894,8 @@ fn run_case(
         outage_errors(reference, &sol, windows, &opts)
             .map_err(|e| format!("smoothed solution: {e}"))
     });
+    let budgets =
+        keep_solution.then(|| outage_budgets(windows, reference, &run.epochs, &input.imu.epochs));
     CaseRun {
         case: input.case,
         forward,
@@ -817,6 +903,7 @@ fn run_case(
         gnss_accepted: run.gnss_accepted,
         gnss_rejected: run.gnss_rejected,
         forward_solution: keep_solution.then_some(forward_solution),
+        budgets,
     }
 }
 
@@ -886,7 +973,7 @@ pub fn vehicle_run(
                         fixes,
                         session: session.clone(),
                         // Without a room calibration, (b) removes the static-start gyro bias.
-                        prime: case == Case::Room && thermal.is_none(),
+                        prime: case == Case::RoomBias && thermal.is_none(),
                     };
                     run_case(input, sc, &windows, &sim.truth, detail)
                 })
@@ -925,25 +1012,29 @@ pub fn vehicle_run(
             let results: Vec<CaseRun> = Case::processed(thermal.is_some())
                 .par_iter()
                 .map(|&case| {
-                    // With a thermal model (csv data with temperature): (b) its room
-                    // calibration, (c) the whole model; without: (b) removes the
-                    // static-start gyro bias.
+                    // With a thermal model (csv data with temperature): (b), (d) and (c)
+                    // from its room calibration and thermal deltas; without: (b) removes
+                    // the static-start gyro bias.
                     let stream = match (case, thermal, &rec.rates) {
-                        (Case::Room, Some(t), Some(r)) => {
-                            let room = *t.model.calibration();
-                            r.stream("room calibration", |_, w, f| {
-                                Ok((room.gyro.apply(w), room.accel.apply(f)))
+                        (Case::Raw, _, _) | (_, None, _) => Ok(rec.imu.clone()),
+                        (_, Some(t), Some(r)) => {
+                            let temp = r.temperature_c.as_deref();
+                            let ready = match (case, temp) {
+                                (Case::Thermal, None) => Err("no temperature column".to_string()),
+                                (Case::RoomBias, _) => check_bias_only(&t.model),
+                                _ => Ok(()),
+                            };
+                            ready.and_then(|()| {
+                                r.stream(case.label(), |k, w, f| {
+                                    let t_c = temp.map_or(f64::NAN, |v| v[k]);
+                                    compensate_case(case, &t.model, w, f, t_c)
+                                        .map_err(|e| format!("sample {k}: {e}"))
+                                })
                             })
                         }
-                        (Case::Thermal, Some(t), Some(r)) => match &r.temperature_c {
-                            Some(temp) => r.stream("room + thermal", |k, w, f| {
-                                t.model
-                                    .compensate(w, f, temp[k])
-                                    .map_err(|e| format!("sample {k}: {e}"))
-                            }),
-                            None => Err("no temperature column".to_string()),
-                        },
-                        _ => Ok(rec.imu.clone()),
+                        (_, Some(_), None) => {
+                            Err("a thermal model needs the rates log (csv vehicle data)".into())
+                        }
                     };
                     let imu = match stream {
                         Ok(s) => s,
@@ -956,7 +1047,7 @@ pub fn vehicle_run(
                         imu,
                         fixes: &rec.fixes,
                         session: session.clone(),
-                        prime: case == Case::Room && thermal.is_none(),
+                        prime: case == Case::RoomBias && thermal.is_none(),
                     };
                     run_case(input, sc, &windows, &reference, detail)
                 })

@@ -4,6 +4,7 @@
 
 use serde::Serialize;
 
+use super::budget::{OutageBudget, Reversal, ReversalCause, reversals};
 use super::monte_carlo::{ExperimentResult, MonteCarloSummary};
 use super::run::{Case, Prepared, VehicleRun};
 use crate::eval::metrics::OutageReport;
@@ -185,7 +186,8 @@ pub fn csv(header: &[String], rows: &[Vec<String>]) -> String {
     s
 }
 
-/// The paper's reference figures (Table 1 means).
+/// The paper's reference figures (Table 1 means): column 2, without scale factor and
+/// thermal compensation models, m.
 pub const PAPER_MEAN_ROOM_M: f64 = 1254.2;
 /// The paper's mean with the thermal model, m.
 pub const PAPER_MEAN_THERMAL_M: f64 = 150.1361;
@@ -205,6 +207,8 @@ pub struct CaseDocument<'a> {
     pub gnss_accepted: usize,
     /// Fixes rejected by the gate.
     pub gnss_rejected: usize,
+    /// Error budget per outage ([`super::budget`]).
+    pub budgets: Option<&'a [Option<OutageBudget>]>,
 }
 
 /// The experiment as one JSON-ready document.
@@ -224,11 +228,13 @@ pub struct ExperimentDocument<'a> {
     pub vehicle_temperature_c: Option<(f64, f64)>,
     /// Detailed run (run 0).
     pub run0: Vec<CaseDocument<'a>>,
+    /// Run 0's outages where a more compensated case ended worse, with the cause.
+    pub run0_reversals: Vec<Reversal>,
     /// Monte Carlo statistics.
     pub monte_carlo: &'a MonteCarloSummary,
     /// Per-run mean end-of-outage errors (forward), per case label.
     pub per_run_forward_mean_end_m: Vec<(String, Vec<Option<f64>>)>,
-    /// The paper's means (room calibration only, with thermal model), m.
+    /// The paper's means (biases only, with scale factor and thermal model), m.
     pub paper_means_m: (f64, f64),
 }
 
@@ -249,6 +255,7 @@ impl<'a> ExperimentDocument<'a> {
                     .map(|s| s.as_ref().map_err(String::as_str)),
                 gnss_accepted: c.gnss_accepted,
                 gnss_rejected: c.gnss_rejected,
+                budgets: c.budgets.as_deref(),
             })
             .collect();
         let per_run = r.per_run_forward_means();
@@ -260,6 +267,7 @@ impl<'a> ExperimentDocument<'a> {
             reference_start_s: p.span_s.0,
             vehicle_temperature_c: r.detailed.temperature_c,
             run0,
+            run0_reversals: reversals(&r.detailed),
             monte_carlo: &r.summary,
             per_run_forward_mean_end_m: per_run,
             paper_means_m: (PAPER_MEAN_ROOM_M, PAPER_MEAN_THERMAL_M),
@@ -284,6 +292,75 @@ pub fn thermal_bias_change(
     ))
 }
 
+/// Where more compensation did worse, as plain text lines: how often each pair reversed
+/// over all runs, and run 0's reversals with their causes ([`super::budget`]); ties
+/// (within 5 %) in one line.
+pub fn reversal_explanation(r: &ExperimentResult) -> Vec<String> {
+    let mut out = Vec::new();
+    let counts: Vec<String> = r
+        .summary
+        .reversals
+        .iter()
+        .filter(|c| c.compared > 0)
+        .map(|c| {
+            format!(
+                "{} worse than {} in {} of {} outages ({:.0} %; {} by more than 5 %)",
+                c.case.label(),
+                c.than.label(),
+                c.worse,
+                c.compared,
+                100.0 * c.worse as f64 / c.compared as f64,
+                c.worse_beyond_tie
+            )
+        })
+        .collect();
+    if counts.is_empty() {
+        return out;
+    }
+    out.push(format!(
+        "Over {} run(s), end-of-outage error, forward filter: {}.",
+        r.summary.runs,
+        counts.join("; ")
+    ));
+    let (ties, rev): (Vec<Reversal>, Vec<Reversal>) = reversals(&r.detailed)
+        .into_iter()
+        .partition(|v| v.cause == ReversalCause::Tie);
+    if rev.is_empty() {
+        out.push(
+            "In run 0 no more compensated case ended an outage worse than a less compensated one \
+             by more than 5 %."
+                .into(),
+        );
+    } else {
+        out.push(format!(
+            "Run 0, outages where a more compensated case ended worse by more than 5 % ({}). \
+             Each case's error is split by coasting the strapdown mechanization through the \
+             outage: from the filter's state with the exact start (start state), from the exact \
+             start with the filter's increments (sensor error), and from the exact start with \
+             the case's stream before the filter's correction (left by the compensation alone):",
+            rev.len()
+        ));
+        out.extend(rev.iter().map(|v| format!("• {}", v.describe())));
+    }
+    if !ties.is_empty() {
+        out.push(format!(
+            "Ties (worse by at most 5 %): {}.",
+            ties.iter()
+                .map(|v| format!(
+                    "#{} {} {} m vs {} {} m",
+                    v.outage + 1,
+                    v.case.label(),
+                    fmt_m(v.end_m),
+                    v.than.label(),
+                    fmt_m(v.than_end_m)
+                ))
+                .collect::<Vec<_>>()
+                .join("; ")
+        ));
+    }
+    out
+}
+
 /// The ratio (b)/(c) beside the paper's 8.4× and what sets it, as plain text lines.
 pub fn ratio_explanation(p: &Prepared, r: &ExperimentResult) -> Vec<String> {
     let paper = PAPER_MEAN_ROOM_M / PAPER_MEAN_THERMAL_M;
@@ -291,8 +368,10 @@ pub fn ratio_explanation(p: &Prepared, r: &ExperimentResult) -> Vec<String> {
     let s = &r.summary;
     match &s.ratio_room_over_thermal {
         Some(q) => out.push(format!(
-            "Ratio (b)/(c) of the mean 60-s end-of-outage error, forward filter, over {} run(s): \
-             {:.2}× ({:.0} % interval {:.2}–{:.2}×). The paper: {:.1}× ({:.0} m → {:.0} m).",
+            "Ratio (b)/(c) of the mean 60-s end-of-outage error, forward filter, over {} run(s) \
+             — room biases only against bias, scale factor and thermal model, the paper's \
+             columns 2 and 3: {:.2}× ({:.0} % interval {:.2}–{:.2}×). The paper: {:.1}× \
+             ({:.0} m → {:.0} m).",
             q.runs,
             q.ratio,
             100.0 * q.confidence,
@@ -310,7 +389,34 @@ pub fn ratio_explanation(p: &Prepared, r: &ExperimentResult) -> Vec<String> {
     if s.ratio_room_over_thermal.is_none() {
         return out;
     }
+    if let Some(q) = &s.ratio_full_room_over_thermal {
+        out.push(format!(
+            "Ratio (d)/(c) — the full room calibration (bias, scale factor, misalignment at \
+             25 °C) against the same plus the thermal model, i.e. what the thermal model alone \
+             buys: {:.2}× ({:.0} % interval {:.2}–{:.2}×).",
+            q.ratio,
+            100.0 * q.confidence,
+            q.lo,
+            q.hi
+        ));
+    }
     out.push("What sets the ratio:".into());
+    let mean_of = |c: Case| {
+        s.cases
+            .iter()
+            .find(|x| x.case == c)
+            .and_then(|x| x.forward_mean_end_m)
+            .map(|m| m.mean)
+    };
+    if let (Some(b), Some(d)) = (mean_of(Case::RoomBias), mean_of(Case::RoomFull)) {
+        out.push(format!(
+            "• scale factor and misalignment: (b) removes only the biases; correcting scale \
+             factor and misalignment as well, case (d), moves the mean from {} m to {} m. The \
+             rest of the gap to (c) is the thermal model's.",
+            fmt_m(b),
+            fmt_m(d)
+        ));
+    }
     if let (Some((t0, t1)), Some(th)) = (r.detailed.temperature_c, &r.thermal) {
         let d = thermal_bias_change(&th.model, t0, t1);
         out.push(format!(
