@@ -18,7 +18,9 @@ pub struct InputArgs {
     /// Sample rate in Hz (required when the file has no time column).
     #[arg(long, value_name = "HZ")]
     pub rate: Option<f64>,
-    /// Time column, by 1-based number or header name; omit for logs without time stamps.
+    /// Time column, by 1-based number or header name. Omitted: a header field named t,
+    /// time, timestamp, time_s, stamp, sec, seconds, gps_time, gpst or time_stamp (any case,
+    /// unit in brackets) is the time; `none` reads such a field as data.
     #[arg(long, value_name = "COL")]
     pub time_column: Option<String>,
     /// Unit of the time column: s, ms, us, ns.
@@ -71,7 +73,13 @@ impl InputArgs {
         {
             anyhow::bail!("--rate must be a positive number of Hz, got {r}");
         }
-        if let Some(t) = &self.time_column {
+        if self
+            .time_column
+            .as_deref()
+            .is_some_and(|t| t.eq_ignore_ascii_case("none"))
+        {
+            o.detect_time_column = false;
+        } else if let Some(t) = &self.time_column {
             o.time_column = Some(t.parse()?);
             o.time_unit = match &self.time_unit {
                 Some(u) => Some(parse_time_unit(u)?),
@@ -101,6 +109,9 @@ impl InputArgs {
         let log = read_log_file(path, &opts)?;
         if log.is_empty() {
             anyhow::bail!("{}: no data rows", path.display());
+        }
+        for n in &log.notes {
+            eprintln!("note: {n}");
         }
         Ok(log)
     }

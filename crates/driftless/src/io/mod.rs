@@ -70,7 +70,9 @@ pub fn resolve_data_path(p: &std::path::Path, base_dir: &std::path::Path) -> std
 }
 
 /// Reads a log file, choosing the reader by content: files starting with the `DRIFTLOG`
-/// magic are read as binary logs (`opts` is then ignored), anything else as delimited text.
+/// magic are read as binary logs (`opts` is then ignored), gzip files (`.gz`, by their
+/// magic bytes) are decompressed on the fly and then read the same way, anything else as
+/// delimited text.
 pub fn read_log_file(
     path: impl AsRef<std::path::Path>,
     opts: &TextOptions,
@@ -84,9 +86,40 @@ pub fn read_log_file(
             path: path.display().to_string(),
             error,
         })?;
+    if magic.starts_with(&GZIP_MAGIC) {
+        return read_gzip_file(path, opts);
+    }
     if magic.as_slice() == binary::MAGIC {
         read_binary_file(path)
     } else {
         read_text_file(path, opts)
+    }
+}
+
+/// The first two bytes of a gzip member (RFC 1952 §2.3.1: ID1 = 31, ID2 = 139).
+pub const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+
+/// Reads a gzip-compressed log (every member, as `gzip -dc` does), choosing the reader
+/// by the decompressed content as [`read_log_file`] does. A corrupt or truncated stream is
+/// an error naming the file, never a shorter log.
+fn read_gzip_file(path: &std::path::Path, opts: &TextOptions) -> Result<ImuLog, LogError> {
+    use std::io::Read;
+    let (file, _, name) = error::open_file(path)?;
+    let mut gz =
+        flate2::read::MultiGzDecoder::new(std::io::BufReader::with_capacity(1 << 20, file));
+    let mut head = Vec::with_capacity(8);
+    (&mut gz)
+        .take(8)
+        .read_to_end(&mut head)
+        .map_err(|error| LogError::Io {
+            path: name.clone(),
+            error,
+        })?;
+    let is_binary = head.as_slice() == binary::MAGIC;
+    let stream = std::io::Cursor::new(head).chain(gz);
+    if is_binary {
+        binary::read_binary(stream, &name)
+    } else {
+        read_text(stream, &name, opts)
     }
 }

@@ -128,8 +128,13 @@ pub struct TextOptions {
     /// Column names from the caller, one per field. Used instead of the header's names
     /// when there is a header, and instead of `col1`, `col2`, … when there is none.
     pub column_names: Option<Vec<String>>,
-    /// The time column, or `None` for a log without time stamps (then `rate_hz` is needed).
+    /// The time column, or `None`: then a header field named as a time column
+    /// ([`TIME_COLUMN_NAMES`], when `detect_time_column`) is taken, else the log has no
+    /// time stamps and `rate_hz` is needed.
     pub time_column: Option<ColumnRef>,
+    /// Take a header field named as a time column ([`TIME_COLUMN_NAMES`]) for the time
+    /// when `time_column` is `None` (on by default; off reads such a field as data).
+    pub detect_time_column: bool,
     /// Unit of the time column; `None` takes the header's bracketed unit, else seconds.
     pub time_unit: Option<TimeUnit>,
     /// Data columns to keep, in output order. Empty keeps every column except time.
@@ -162,6 +167,7 @@ impl Default for TextOptions {
             header: HeaderMode::Auto,
             column_names: None,
             time_column: None,
+            detect_time_column: true,
             time_unit: None,
             columns: Vec::new(),
             default_unit: None,
@@ -447,6 +453,8 @@ struct Plan {
     header_line: Option<usize>,
     /// Field of the week column, whose output vector comes after the channels'.
     week_field: Option<usize>,
+    /// The time column was found by its header name (for the log's notes).
+    time_detected: bool,
 }
 
 enum FieldErr {
@@ -687,6 +695,48 @@ fn split_name_unit(raw: &str) -> (String, Option<String>) {
     (t.to_owned(), None)
 }
 
+/// Header names (case-insensitive, unit in brackets stripped, a leading `#` ignored)
+/// taken for the time column when none is given.
+pub const TIME_COLUMN_NAMES: [&str; 10] = [
+    "t",
+    "time",
+    "timestamp",
+    "time_s",
+    "stamp",
+    "sec",
+    "seconds",
+    "gps_time",
+    "gpst",
+    "time_stamp",
+];
+
+/// The one header field named as a time column, if any; two such fields are an error
+/// (which one is the time cannot be guessed).
+fn detect_time_field(names: &[String], at: &Location) -> Result<Option<usize>, LogError> {
+    let hits: Vec<usize> = (0..names.len())
+        .filter(|&i| {
+            let n = names[i].trim().trim_start_matches('#').trim();
+            TIME_COLUMN_NAMES.iter().any(|t| n.eq_ignore_ascii_case(t))
+        })
+        .collect();
+    match hits.as_slice() {
+        [] => Ok(None),
+        [f] => Ok(Some(*f)),
+        many => Err(LogError::InvalidOptions {
+            at: at.clone(),
+            message: format!(
+                "{} header fields look like time columns ({}): name the time column with \
+                 `--time-column`",
+                many.len(),
+                many.iter()
+                    .map(|&i| format!("{}={}", i + 1, names[i]))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }),
+    }
+}
+
 fn resolve(r: &ColumnRef, names: &[String], at: &Location) -> Result<usize, LogError> {
     let unknown = || LogError::UnknownColumn {
         at: at.clone(),
@@ -888,7 +938,26 @@ fn make_plan(
 
     let mut slots: Vec<Option<Slot>> = vec![None; nfields];
     let mut nout = 0;
-    let time_field = match &opts.time_column {
+    let detected = match (&opts.time_column, opts.detect_time_column && has_header) {
+        (None, true) => detect_time_field(&names, &at_line)?,
+        _ => None,
+    };
+    if opts.time_column.is_none() && detected.is_none() && opts.rate_hz.is_none() {
+        return Err(LogError::InvalidOptions {
+            at: if has_header { at_line } else { at_input },
+            message: format!(
+                "no time column and no sample rate: no header field is named as a time column \
+                 ({}); give the time column (`--time-column NAME|N`) or the sample rate \
+                 (`--rate HZ`)",
+                TIME_COLUMN_NAMES.join(", ")
+            ),
+        });
+    }
+    let time_ref = opts
+        .time_column
+        .clone()
+        .or(detected.map(|f| ColumnRef::Index(f + 1)));
+    let time_field = match &time_ref {
         None => None,
         Some(r) => {
             let f = resolve(r, &names, loc)?;
@@ -995,6 +1064,7 @@ fn make_plan(
         channels,
         header_line: has_header.then_some(line_no),
         week_field,
+        time_detected: detected.is_some(),
     };
     // The first data row: whole, dropped as a cut record, or an error citing a good row.
     let k = usize::from(has_header);
@@ -1060,8 +1130,12 @@ fn validate(opts: &TextOptions, source: &str) -> Result<(), LogError> {
             opts.rate_tolerance
         ));
     }
-    if opts.time_column.is_none() && opts.rate_hz.is_none() {
-        return bad("no time column and no rate_hz: cannot determine the sample interval τ0; give one of them".into());
+    if opts.time_column.is_none() && opts.rate_hz.is_none() && !opts.detect_time_column {
+        return bad(
+            "no time column and no sample rate: cannot determine the sample interval τ0; give \
+             the time column (`--time-column NAME|N`) or the sample rate (`--rate HZ`)"
+                .into(),
+        );
     }
     Ok(())
 }
@@ -1332,6 +1406,16 @@ fn read_impl<R: Read>(
         c.shrink_to_fit();
     }
     let map = LineMap { anchors };
+    if plan.time_detected
+        && let Some(f) = plan.time_field
+    {
+        notes.push(format!(
+            "{source}: column {} ({}) taken for the time by its name (`--time-column` names \
+             another)",
+            f + 1,
+            plan.names[f]
+        ));
+    }
     let week = match plan.week_field {
         Some(wf) => {
             let weeks = out.pop().unwrap_or_default();
