@@ -5,11 +5,11 @@ use crate::output::{Table, sci};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use driftless::allan::analysis::{AnalysisConfig, ChannelResult, analyse_channels};
-use driftless::allan::checks;
 use driftless::allan::fit::FitConfig;
 use driftless::allan::noise_model::NoiseModel;
 use driftless::allan::taus::TauSpec;
 use driftless::allan::{DataType, Estimator};
+use driftless::allan::{checks, plausibility};
 use driftless::io::{ImuLog, Quantity};
 use std::path::{Path, PathBuf};
 
@@ -203,6 +203,19 @@ pub fn analyse_log(
             }
         };
         warnings.extend(checks::stationarity_warning(name, y, log.tau0_s));
+    }
+    if cfg.data_type == DataType::Frequency {
+        let inputs: Vec<plausibility::ChannelInput<'_>> = keep
+            .iter()
+            .zip(&data)
+            .map(|(&i, d)| plausibility::ChannelInput {
+                name: &log.channels[i].name,
+                quantity: log.channels[i].quantity,
+                stated_unit: &log.channels[i].source_unit,
+                values: d,
+            })
+            .collect();
+        warnings.extend(plausibility::unit_warnings(&inputs, log.tau0_s));
     }
     if let Some(model) = &noise {
         let record_s = log.len() as f64 * log.tau0_s;

@@ -13,6 +13,7 @@ pub mod estimators;
 pub mod fit;
 pub mod noise_model;
 pub mod phase;
+pub mod plausibility;
 pub mod taus;
 
 use serde::{Deserialize, Serialize};
