@@ -6,11 +6,13 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use driftless::allan::analysis::{AnalysisConfig, ChannelResult, analyse_channels};
 use driftless::allan::fit::FitConfig;
+use driftless::allan::lines::{self, ChannelLines, LineConfig, SpectralLine};
 use driftless::allan::noise_model::NoiseModel;
 use driftless::allan::taus::TauSpec;
 use driftless::allan::{DataType, Estimator};
 use driftless::allan::{checks, plausibility};
 use driftless::io::{ImuLog, Quantity};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -57,6 +59,10 @@ pub struct AllanArgs {
     /// Skip the noise-term fit.
     #[arg(long)]
     pub no_fit: bool,
+    /// Fit the noise model to the data as they are, spectral lines included (by default
+    /// lines — vibration, pumps, mains — are found, reported and notched out before the fit).
+    #[arg(long)]
+    pub keep_lines: bool,
     /// Machine-readable output (see README: the `allan` JSON contract).
     #[arg(long)]
     pub json: bool,
@@ -79,6 +85,8 @@ pub struct AllanOutput {
     /// Whether the record suits the analysis: not static, too short for a fitted term
     /// (see `driftless::allan::checks`).
     pub warnings: Vec<String>,
+    /// Spectral lines found per channel (removed before the noise fit).
+    pub lines: Vec<ChannelLines>,
 }
 
 /// The analysis settings from the flags.
@@ -109,6 +117,7 @@ pub fn analyse_log(
     cfg: &AnalysisConfig,
     fit: Option<&FitConfig>,
     scale: Option<f64>,
+    remove_lines: bool,
 ) -> Result<AllanOutput> {
     let keep: Vec<usize> = (0..log.channels.len())
         .filter(|&i| log.channels[i].quantity != Quantity::Temperature)
@@ -164,22 +173,88 @@ pub fn analyse_log(
         })
         .collect();
 
+    // Spectral lines (rate data only): found on each channel's longest segment, notched
+    // out of every segment before the noise fit.
+    let found: Vec<Vec<SpectralLine>> = if remove_lines && cfg.data_type == DataType::Frequency {
+        inputs
+            .par_iter()
+            .map(|(_, segs)| {
+                let longest = segs.iter().max_by_key(|s| s.len()).copied().unwrap_or(&[]);
+                lines::detect_lines(longest, log.tau0_s, &LineConfig::default())
+            })
+            .collect()
+    } else {
+        vec![Vec::new(); inputs.len()]
+    };
+    let cleaned: Vec<Option<Vec<Vec<f64>>>> = found
+        .par_iter()
+        .zip(&inputs)
+        .map(|(l, (_, segs))| {
+            (!l.is_empty()).then(|| {
+                segs.iter()
+                    .map(|s| lines::remove_lines(s, log.tau0_s, l))
+                    .collect()
+            })
+        })
+        .collect();
+    let fit_inputs: Vec<(&str, Vec<&[f64]>)> = inputs
+        .iter()
+        .zip(&cleaned)
+        .map(|((name, segs), c)| match c {
+            Some(c) => (*name, c.iter().map(Vec::as_slice).collect()),
+            None => (*name, segs.clone()),
+        })
+        .collect();
+    let any_lines = cleaned.iter().any(Option::is_some);
+    let oadev_cfg = AnalysisConfig {
+        estimator: Estimator::Oadev,
+        taus: TauSpec::Log(100),
+        fast: false,
+        ..cfg.clone()
+    };
+    // The line-free OADEV curves, and the same τ on the data as they are, for the σ shift.
+    let clean_curves = if any_lines && fit.is_some() {
+        Some(analyse_channels(&fit_inputs, log.tau0_s, &oadev_cfg)?)
+    } else {
+        None
+    };
+    let mut lines_out = Vec::new();
+    if let Some(cc) = &clean_curves {
+        let raw_curves = if cfg.estimator == Estimator::Oadev && cfg.taus == TauSpec::Log(100) {
+            None
+        } else {
+            Some(analyse_channels(&inputs, log.tau0_s, &oadev_cfg)?)
+        };
+        let raw = raw_curves.as_deref().unwrap_or(&results);
+        for (k, l) in found.iter().enumerate() {
+            if l.is_empty() {
+                continue;
+            }
+            let tau: Vec<f64> = cc[k].points.iter().map(|p| p.tau).collect();
+            let with: Vec<f64> = raw[k].points.iter().map(|p| p.dev).collect();
+            let without: Vec<f64> = cc[k].points.iter().map(|p| p.dev).collect();
+            let (inc, at) = lines::sigma_increase(&tau, &with, &without);
+            lines_out.push(ChannelLines {
+                channel: inputs[k].0.to_string(),
+                lines: l.clone(),
+                max_sigma_increase: inc,
+                at_tau_s: at,
+            });
+        }
+    }
     let noise = match fit {
         None => None,
         Some(fc) => {
-            // The noise model is an Allan-variance model: fit an OADEV curve. Reuse the
-            // requested one when it is OADEV, otherwise compute one on a log grid.
+            // The noise model is an Allan-variance model: fit an OADEV curve (of the
+            // line-free data). Reuse the requested one when it is that curve, otherwise
+            // compute one on a log grid.
             let oadev_results;
-            let curves: &[ChannelResult] = if cfg.estimator == Estimator::Oadev {
+            let curves: &[ChannelResult] = if let Some(cc) = &clean_curves {
+                cc
+            } else if cfg.estimator == Estimator::Oadev {
                 &results
             } else {
-                let c = AnalysisConfig {
-                    estimator: Estimator::Oadev,
-                    taus: TauSpec::Log(100),
-                    fast: false,
-                    ..cfg.clone()
-                };
-                oadev_results = analyse_channels(&inputs, log.tau0_s, &c)?;
+                oadev_results = analyse_channels(&inputs, log.tau0_s, &oadev_cfg)?;
                 &oadev_results
             };
             Some(NoiseModel::from_curves(
@@ -217,6 +292,13 @@ pub fn analyse_log(
             .collect();
         warnings.extend(plausibility::unit_warnings(&inputs, log.tau0_s));
     }
+    for l in &lines_out {
+        let unit = keep
+            .iter()
+            .position(|&i| log.channels[i].name == l.channel)
+            .map_or("", |k| units[k].as_str());
+        warnings.push(l.describe(unit));
+    }
     if let Some(model) = &noise {
         let record_s = log.len() as f64 * log.tau0_s;
         for (c, r) in model.channels.iter().zip(&results) {
@@ -236,6 +318,7 @@ pub fn analyse_log(
         units,
         noise,
         warnings,
+        lines: lines_out,
     })
 }
 
@@ -270,7 +353,7 @@ pub fn run(a: AllanArgs) -> Result<()> {
             log.len()
         ),
     );
-    let out = analyse_log(&log, &cfg, fit.as_ref(), a.scale)?;
+    let out = analyse_log(&log, &cfg, fit.as_ref(), a.scale, !a.keep_lines)?;
     spinner.finish_and_clear();
     for w in &out.warnings {
         eprintln!("warning: {w}");
@@ -341,7 +424,12 @@ pub fn json_output(out: &AllanOutput) -> serde_json::Value {
         Some(m) => serde_json::to_value(m).unwrap_or(serde_json::Value::Null),
         None => serde_json::Value::Null,
     };
-    serde_json::json!({ "channels": channels, "noise": noise, "warnings": out.warnings })
+    serde_json::json!({
+        "channels": channels,
+        "noise": noise,
+        "warnings": out.warnings,
+        "lines": out.lines,
+    })
 }
 
 fn human_output(out: &AllanOutput, log: &ImuLog, file: &Path) -> String {

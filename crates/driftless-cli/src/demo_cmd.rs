@@ -171,7 +171,7 @@ fn noise_demo(a: DemoArgs) -> Result<()> {
         rate_random_walk: true,
         ..FitConfig::NONE
     };
-    let out = analyse_log(&log, &cfg, Some(&fit_cfg), None)?;
+    let out = analyse_log(&log, &cfg, Some(&fit_cfg), None, true)?;
     let t_allan = t0.elapsed();
     sp.finish_and_clear();
 
