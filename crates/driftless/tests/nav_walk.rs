@@ -158,6 +158,14 @@ enum Variant {
     /// The defaults with the σ floor a moving antenna calls for
     /// (`gnss.sigma_floor_m = 0.2`, vertical 0.4 m): the documented hand-held setting.
     MovingAntennaFloor,
+    /// The hand-held setting with a smaller floor, 0.1 m / 0.2 m.
+    SmallFloor,
+    /// The defaults with the rotation-driven attitude noise of an unmodelled gyro axis
+    /// coupling of 0.5 % (`FilterConfig::gyro_coupling_sigma_rad`; the preset's
+    /// misalignment is 4–9 mrad), file σ.
+    Coupling,
+    /// The hand-held setting plus a 0.2 % axis coupling.
+    FloorAndCoupling,
     Chi2Gate,
     SigmaFloor,
     NoGate,
@@ -176,9 +184,12 @@ enum Variant {
 }
 
 impl Variant {
-    const STUDY: [Variant; 5] = [
+    const STUDY: [Variant; 8] = [
         Variant::Default,
         Variant::MovingAntennaFloor,
+        Variant::SmallFloor,
+        Variant::Coupling,
+        Variant::FloorAndCoupling,
         Variant::Chi2Gate,
         Variant::SigmaFloor,
         Variant::NoGate,
@@ -195,6 +206,9 @@ impl Variant {
         match self {
             Variant::Default => "defaults (robust gate)",
             Variant::MovingAntennaFloor => "defaults + σ floor 0.2/0.4 m",
+            Variant::SmallFloor => "defaults + σ floor 0.1/0.2 m",
+            Variant::Coupling => "defaults + axis coupling 0.5 %",
+            Variant::FloorAndCoupling => "defaults + σ floor 0.2/0.4 m + coupling 0.2 %",
             Variant::Chi2Gate => "A χ² gate (chi2:0.9999)",
             Variant::SigmaFloor => "B σ floor 0.1/0.2 m",
             Variant::NoGate => "C no gate",
@@ -214,6 +228,19 @@ impl Variant {
                 c.sigma_floor_m = Some((0.2, 0.4));
                 return c;
             }
+            Variant::SmallFloor => {
+                c.sigma_floor_m = Some((0.1, 0.2));
+                return c;
+            }
+            Variant::Coupling => {
+                c.filter.gyro_coupling_sigma_rad = 5e-3;
+                return c;
+            }
+            Variant::FloorAndCoupling => {
+                c.sigma_floor_m = Some((0.2, 0.4));
+                c.filter.gyro_coupling_sigma_rad = 2e-3;
+                return c;
+            }
             _ => {}
         }
         c.min_speed_m_s = MIN_SPEED_M_S;
@@ -221,6 +248,9 @@ impl Variant {
         match self {
             Variant::Default
             | Variant::MovingAntennaFloor
+            | Variant::SmallFloor
+            | Variant::Coupling
+            | Variant::FloorAndCoupling
             | Variant::Chi2Gate
             | Variant::RigidAntenna
             | Variant::Chi2GateTrueHeading => {}
@@ -311,12 +341,16 @@ struct SeedFigures {
     ends_30: Vec<OutageEnd>,
     /// Heading error of the initial state against the truth, deg.
     init_yaw_err_deg: f64,
+    /// The gyro biases were primed from the static start.
+    primed: bool,
 }
 
 /// A forward run and its full-GNSS figure (Σ e² and count of the one-step prediction
 /// errors, `SessionResult::horizontal_rms_m`'s definition).
 struct Forward {
     run: ForwardRun,
+    /// The session primed the gyro biases from the static start.
+    primed: bool,
     t_init: f64,
     init_yaw_rad: f64,
     pred_ss: f64,
@@ -334,6 +368,7 @@ fn forward(imu: &ImuStream, sim: &Simulation, cfg: &SessionConfig, true_attitude
         let r = run_session(imu, g, cfg).expect("session");
         let (rms, n) = r.horizontal_rms_m.unwrap_or((0.0, 0));
         return Forward {
+            primed: r.primed_gyro_bias_rad_s.is_some(),
             t_init: r.init.nav.time_s,
             init_yaw_rad: Euler::from_dcm(&r.init.nav.q_bn.to_dcm()).yaw_rad,
             pred_ss: rms * rms * n as f64,
@@ -378,6 +413,7 @@ fn forward(imu: &ImuStream, sim: &Simulation, cfg: &SessionConfig, true_attitude
     }
     Forward {
         run,
+        primed: primed.is_some(),
         t_init: t0,
         init_yaw_rad: y,
         pred_ss,
@@ -453,6 +489,7 @@ fn seed_figures(sim: &Simulation, variant: Variant) -> SeedFigures {
     let dyaw = (full.init_yaw_rad - sim.truth.roll_pitch_yaw_rad[k][2]).to_degrees();
     SeedFigures {
         init_yaw_err_deg: (dyaw + 180.0).rem_euclid(360.0) - 180.0,
+        primed: full.primed,
         accepted: full.run.gnss_accepted,
         rejected: full.run.gnss_rejected,
         forced: full.run.gnss_forced,
@@ -478,6 +515,8 @@ struct Pooled {
     ends_30: (f64, f64, f64, f64),
     /// RMS initial heading error, deg.
     init_yaw_rms_deg: f64,
+    /// Seeds whose gyro biases were primed from the static start.
+    primed: usize,
 }
 
 impl Pooled {
@@ -513,6 +552,7 @@ fn pool(figs: &[SeedFigures]) -> Pooled {
         ends_15: ends(figs.iter().flat_map(|f| f.ends_15.clone()).collect()),
         ends_30: ends(figs.iter().flat_map(|f| f.ends_30.clone()).collect()),
         init_yaw_rms_deg: (sum(|f| f.init_yaw_err_deg.powi(2)) / figs.len() as f64).sqrt(),
+        primed: figs.iter().filter(|f| f.primed).count(),
     }
 }
 
@@ -541,6 +581,14 @@ fn study(variants: &[Variant]) -> Vec<Pooled> {
                 sims.iter().map(|s| seed_figures(s, v)).collect()
             };
             let p = pool(&figs);
+            if std::env::var_os("WALK_SEEDS").is_some() {
+                for (i, f) in figs.iter().enumerate() {
+                    let r = (f.pred_ss / f.pred_n as f64).sqrt() / (f.fix_ss / f.fix_n as f64).sqrt();
+                    let e15: Vec<String> = f.ends_15.iter().map(|e| format!("{:.0}/{:.0}", e.error_m, 3.0 * e.sigma_h_m)).collect();
+                    let e30: Vec<String> = f.ends_30.iter().map(|e| format!("{:.0}/{:.0}", e.error_m, 3.0 * e.sigma_h_m)).collect();
+                    eprintln!("  seed {} ratio {r:.2} yaw0 {:.1} rej {} | {} | {}", i + 1, f.init_yaw_err_deg, f.rejected, e15.join(" "), e30.join(" "));
+                }
+            }
             let row = |e: (f64, f64, f64, f64)| {
                 format!(
                     "{:.1} %, {:.2} m, {:.2} m, {:.1}",
@@ -760,23 +808,16 @@ fn walk_simulation_matches_the_scenario_and_the_filter_runs() {
     );
 }
 
-/// The study's bars under the default filter (module documentation).
-#[test]
-#[ignore = "bar not met yet: the defaults reject 0 % of the fixes (bar < 2 %), but with a \
-            1-cm formal σ against 0.28-m correlated antenna motion the filter is over-confident: \
-            one-step RMS 1.93× the fixes' error (bar 1.2×), outage ends inside 3σ in 24 % (15 s) \
-            and 18 % (30 s) of windows (bar 90 %); with a 0.2-m σ floor 1.87×, 89 % and 92 %; \
-            with the IMU's noise terms only every bar is met"]
-fn measure_walk_study_against_the_bars() {
-    let p = study(&[Variant::Default])[0];
+/// The study's bars (module documentation) on the pooled figures of one variant.
+fn assert_bars(p: &Pooled, what: &str) {
     assert!(
         p.rejected_share < 0.02,
-        "(a) {:.2} % of the fixes rejected by the gate (bar < 2 %)",
+        "{what}: (a) {:.2} % of the fixes rejected by the gate (bar < 2 %)",
         100.0 * p.rejected_share
     );
     assert!(
         p.ratio() <= 1.2,
-        "(b) one-step prediction RMS {:.3} m is {:.2}× the fixes' RMS error {:.3} m (bar ≤ 1.2×)",
+        "{what}: (b) one-step prediction RMS {:.3} m is {:.2}× the fixes' RMS error {:.3} m (bar ≤ 1.2×)",
         p.pred_rms_m,
         p.ratio(),
         p.fix_rms_m
@@ -784,8 +825,43 @@ fn measure_walk_study_against_the_bars() {
     for (len, e) in [(15, p.ends_15), (30, p.ends_30)] {
         assert!(
             e.0 >= 0.9,
-            "(c) {len}-s outages: {:.1} % of the ends within 3·√(σN² + σE²) (bar ≥ 90 %)",
+            "{what}: (c) {len}-s outages: {:.1} % of the ends within 3·√(σN² + σE²) (bar ≥ 90 %)",
             100.0 * e.0
+        );
+    }
+}
+
+/// The study's bars under the default filter (module documentation).
+#[test]
+#[ignore = "bar not met: with the file's 1-cm σ against 0.28-m correlated antenna motion the \
+            default filter is over-confident: one-step RMS 1.35× the fixes' error (bar 1.2×), \
+            outage ends inside 3σ in 24 % (15 s) and 22 % (30 s) of windows (bar 90 %); a \
+            default σ floor that fixes it (0.2 m) costs the car drive its full-RTK accuracy \
+            (0.06 → 0.15–0.50 m), so the floor is the hand-held setting, asserted below"]
+fn measure_walk_study_against_the_bars() {
+    let p = study(&[Variant::Default])[0];
+    assert_bars(&p, "defaults");
+}
+
+/// The hand-held setting (defaults + σ floor 0.2 m / 0.4 m) meets every bar of the study
+/// over the 20 seeds, and the session primes the gyro biases of every seed from the
+/// static start (a consumer accelerometer's turn-on bias moves |f̄| by up to ≈ 0.6 m/s²).
+#[test]
+fn walk_study_meets_the_bars_with_the_hand_held_floor() {
+    let p = study(&[Variant::MovingAntennaFloor])[0];
+    assert_eq!(
+        p.primed,
+        SEEDS.count(),
+        "seeds primed from the static start"
+    );
+    assert_bars(&p, "hand-held σ floor");
+    // Consistent, not merely conservative: the mean normalised squared error at the
+    // outage ends is of order 1 (≈ 1 for a consistent filter), not ≪ 1.
+    for (len, e) in [(15, p.ends_15), (30, p.ends_30)] {
+        assert!(
+            e.3 > 0.3 && e.3 < 5.0,
+            "{len}-s outages: mean e²/σ² {:.2} (a consistent filter gives ≈ 1)",
+            e.3
         );
     }
 }
@@ -797,7 +873,7 @@ fn measure_walk_study_against_the_bars() {
 fn measure_walk_filter_variants() {
     let clock = Instant::now();
     let rows = study(&Variant::STUDY);
-    assert_eq!(rows.len(), 5);
+    assert_eq!(rows.len(), Variant::STUDY.len());
     if std::env::var_os("WALK_DIAGNOSTICS").is_some() {
         study(&Variant::DIAGNOSTICS);
     }
