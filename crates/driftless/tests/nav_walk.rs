@@ -14,9 +14,12 @@
 //! **Filter.** `nav::session::run_session` with only the geometry given — lever arm
 //! (0, 0, −0.25) m, mounting identity — and the library's defaults
 //! ([`SessionConfig::new`] over [`FilterConfig::new`]: robust gate, gate recovery 3 s,
-//! alignment from 0.5 m/s, no aids), IMU noise from the `consumer` preset's numbers ([`walk_noise`]); no per-seed
-//! tuning. Variants: the same with the σ floor a moving antenna calls for (0.2 m, 0.4 m
-//! vertical); and, on the older settings (χ² gate 0.9999, heading from 0.8 m/s), **A** the
+//! alignment from 0.5 m/s, no aids, file σ), IMU noise from the `consumer` preset's
+//! numbers ([`walk_noise`]); no per-seed tuning. Variants: the same with the σ floor a
+//! moving antenna calls for (0.2 m, 0.4 m vertical: the hand-held setting) or 0.1 / 0.2 m;
+//! with the rotation-driven attitude noise of an unmodelled gyro axis coupling
+//! (`FilterConfig::gyro_coupling_sigma_rad`, 0.5 %, and 0.2 % on top of the hand-held
+//! floor); and, on the older settings (χ² gate 0.9999, heading from 0.8 m/s), **A** the
 //! χ² gate, **B** the fixes' σ floored at 0.1 m / 0.2 m
 //! (`SessionConfig::sigma_floor_m`), **C** no gate (`FilterConfig::gate = Gate::Off`),
 //! and diagnostics D–H.
@@ -44,37 +47,50 @@
 //!     not bad luck. Bar: ≥ 90 % of windows for each length. Reported alongside:
 //!     mean e_h, mean bound, and the mean of e_h²/(σ_N² + σ_E²) (≈ 1 when consistent).
 //!
-//! **Measured** (release, 2 cores; 1–3 s per variant for 20 seeds × 3 runs;
+//! **Measured** (release, 2 cores; 2–4 s per variant for 20 seeds × 3 runs;
 //! `cargo test --release -p driftless --test nav_walk measure_ -- --ignored --nocapture`,
-//! with `WALK_DIAGNOSTICS=1` for D–H):
+//! with `WALK_DIAGNOSTICS=1` for D–H, `WALK_SEEDS=1` for the per-seed figures):
 //!
 //! | variant | (a) rejected | (b) one-step / fix RMS (worst seed) | (c) 15 s: covered, mean e_h, mean 3σ_h, mean e²/σ² | (c) 30 s: covered, mean e_h, mean 3σ_h, mean e²/σ² |
 //! |---|---|---|---|---|
-//! | defaults | 0.00 % | 0.696 / 0.361 m = 1.93 (5.93) | 23.8 %, 21.2 m, 7.2 m, 122 | 18.3 %, 66.5 m, 23.8 m, 114 |
-//! | defaults + σ floor 0.2 / 0.4 m | 0.00 % | 0.677 / 0.362 m = 1.87 (7.31) | 88.8 %, 13.8 m, 17.0 m, 30.5 | 91.7 %, 43.0 m, 57.2 m, 35.3 |
-//! | A χ² gate | 79.2 % | 1.820 / 0.361 m = 5.04 (12.9) | 17.5 %, 152 m, 86.1 m, 81.3 | 33.3 %, 410 m, 338 m, 36.8 |
-//! | B σ floor 0.1 / 0.2 m | 5.12 % | 0.369 / 0.361 m = 1.02 (4.07) | 81.2 %, 20.1 m, 14.1 m, 20.9 | 83.3 %, 54.7 m, 52.7 m, 12.7 |
-//! | C no gate | 0 % | 0.472 / 0.361 m = 1.31 (2.06) | 6.2 %, 23.6 m, 5.5 m, 252 | 6.7 %, 82.4 m, 20.2 m, 219 |
-//! | D σ floor 0.3 / 0.3 m | 2.46 % | 0.490 / 0.364 m = 1.34 (5.77) | 92.5 %, 14.6 m, 21.0 m, 28.7 | 95.0 %, 36.6 m, 90.4 m, 10.5 |
-//! | E = A, antenna rigid on its lever arm | 3.59 % | 0.209 / 0.235 m = 0.89 (3.44) | 90.0 %, 7.0 m, 6.3 m, 24.6 | 91.7 %, 22.9 m, 24.2 m, 19.9 |
+//! | defaults | 0.00 % | 0.486 / 0.361 m = 1.35 (2.66) | 23.8 %, 18.2 m, 6.9 m, 103 | 21.7 %, 59.5 m, 22.8 m, 95.3 |
+//! | **defaults + σ floor 0.2 / 0.4 m** (hand-held setting) | **0.00 %** | **0.265 / 0.362 m = 0.73 (0.94)** | **97.5 %**, 6.6 m, 16.5 m, 1.9 | **98.3 %**, 21.1 m, 55.8 m, 1.6 |
+//! | defaults + σ floor 0.1 / 0.2 m | 0.00 % | 0.269 / 0.361 m = 0.75 (1.05) | 90.0 %, 6.8 m, 11.7 m, 4.1 | 88.3 %, 22.6 m, 38.2 m, 4.3 |
+//! | defaults + axis coupling 0.5 % | 0.00 % | 0.322 / 0.361 m = 0.89 (1.23) | 57.5 %, 28.5 m, 27.3 m, 13.2 | 71.7 %, 108 m, 151 m, 7.3 |
+//! | defaults + σ floor 0.2 / 0.4 m + coupling 0.2 % | 0.00 % | 0.244 / 0.362 m = 0.68 (0.88) | 98.8 %, 7.4 m, 27.5 m, 0.8 | 98.3 %, 22.7 m, 99.7 m, 0.6 |
+//! | A χ² gate | 78.8 % | 1.651 / 0.361 m = 4.57 (12.9) | 18.8 %, 145 m, 83.9 m, 78.4 | 31.7 %, 419 m, 339 m, 35.6 |
+//! | B σ floor 0.1 / 0.2 m | 1.56 % | 0.269 / 0.361 m = 0.74 (1.04) | 90.0 %, 6.6 m, 11.6 m, 3.9 | 90.0 %, 23.7 m, 41.6 m, 3.9 |
+//! | C no gate | 0 % | 0.471 / 0.361 m = 1.30 (2.06) | 8.8 %, 22.7 m, 5.5 m, 241 | 8.3 %, 76.2 m, 20.1 m, 194 |
+//! | D σ floor 0.3 / 0.3 m | 0.01 % | 0.278 / 0.364 m = 0.76 (0.98) | 100 %, 7.1 m, 20.5 m, 1.3 | 100 %, 23.8 m, 72.6 m, 1.1 |
+//! | E = A, antenna rigid on its lever arm | 0.86 % | 0.164 / 0.235 m = 0.70 (0.88) | 100 %, 0.8 m, 5.4 m, 0.2 | 100 %, 3.8 m, 18.8 m, 0.5 |
 //! | F = D, IMU noise terms only | 0.01 % | 0.276 / 0.364 m = 0.76 (0.98) | 100 %, 5.4 m, 20.6 m, 0.9 | 100 %, 17.9 m, 72.5 m, 0.8 |
-//! | G = D, true initial attitude and velocity | 2.25 % | 0.452 / 0.364 m = 1.24 (4.84) | 92.5 %, 13.4 m, 20.9 m, 27.1 | 95.0 %, 32.9 m, 88.7 m, 9.7 |
-//! | H = A, true initial attitude and velocity | 79.4 % | 1.981 / 0.361 m = 5.48 (16.8) | 18.8 %, 130 m, 83.3 m, 95.9 | 30.0 %, 470 m, 407 m, 35.1 |
+//! | G = D, true initial attitude and velocity | 0.01 % | 0.277 / 0.364 m = 0.76 (0.96) | 100 %, 5.8 m, 20.3 m, 1.0 | 100 %, 19.7 m, 70.6 m, 0.9 |
+//! | H = A, true initial attitude and velocity | 79.0 % | 1.892 / 0.361 m = 5.24 (16.8) | 21.2 %, 123 m, 80.3 m, 89.0 | 30.0 %, 464 m, 393 m, 33.1 |
 //!
-//! Reading: the defaults meet (a) only. Two things break them, each visible on its own:
-//! (1) the 1-cm formal σ against 0.28-m antenna motion: the filter believes every fix to
-//! a centimetre and is over-confident at every outage end (mean e²/σ² ≈ 120); a σ floor
-//! at the motion's size (the hand-held setting, row 2) brings (c) to 89 % / 92 %.
-//! (2) error terms the 21-state filter does not model — the consumer preset's cross-axis
-//! sensitivity, misalignment and g-sensitivity: with the IMU's noise terms only (F) every
-//! bar is met with margin (0.76×, 100 % / 100 %, e²/σ² ≈ 1), while with every term one
-//! or two seeds diverge (worst seed 5–6× the fixes' RMS), which keeps (b) above 1.2×.
-//! Estimating the fixes' σ from the innovations (an innovation-based adaptive R with a
-//! lag-one correlation allowance) was tried and made every figure worse: the innovations
-//! of a filter whose P is inconsistent carry the state's drift, the estimated R grows,
-//! the fixes lose weight and the drift grows further. So did a covariance reset after a
-//! run of inconsistent fixes (it fires every few seconds when R, not P, is too small).
-//! The asserting test below is therefore ignored until the defaults meet the bars.
+//! Reading: the session primes the gyro biases from the 10-s standstill of every seed
+//! (before the static test's gravity tolerance was widened to 1 m/s² — a consumer
+//! accelerometer's 20-mg turn-on bias moves |f̄| by up to ≈ 0.6 m/s² — two seeds were
+//! left with a 0.5-°/s gyro bias and diverged; that, not the unmodelled cross-axis
+//! terms, was what kept (b) above 1.2× with a floor: F ≈ D now). What remains is the 1-cm
+//! formal σ against 0.28-m correlated antenna motion: with the file's σ the defaults
+//! meet (a) only — the filter believes every fix to a centimetre and its σ at the outage
+//! ends is ~10× too small (mean e²/σ² ≈ 100). A floor at the motion's size (the
+//! hand-held setting, 0.2 / 0.4 m) meets every bar with margin and is consistent
+//! (e²/σ² 1.6–1.9); 0.1 m is not enough for 30-s outages. It is not the library default:
+//! on the real car drive (`tests/nav_drive.rs`, rigid roof antenna) a 0.2-m floor raises
+//! the full-RTK one-step RMS from 0.056 to 0.153 m (defaults) and from 0.062 to 0.497 m
+//! (published values; bar 0.10 m). The axis-coupling noise alone does not make the
+//! defaults consistent (57 % / 72 %) and on top of the floor it only trades a little
+//! accuracy for σ (e²/σ² ≈ 0.7); it stays off by default (on the tuned car preset it
+//! lengthens the six-outage mean from 27.85 m to 29.3 m at 0.1 %, 37.7 m at 0.5 %).
+//! Tried and worse, not kept: an innovation-based adaptive R (robust IAE with a lag-one
+//! correlation allowance) and a covariance reset after 8 inconsistent fixes (both with
+//! the unprimed seeds still in); an innovation-scaled σ floor (2 × the running RMS of the
+//! one-step innovations, 10-s time constant) meets the walk's bars (0.84×, 95 % / 98 %)
+//! but runs away on the car (full-RTK 0.27 m defaults, 0.95 m published values, tuned
+//! preset 0.16 m): weaker fixes let the prediction error grow, which raises the floor.
+//! The asserting test of the defaults is therefore ignored; the hand-held setting's
+//! bars are asserted by `walk_study_meets_the_bars_with_the_hand_held_floor`.
 
 use std::path::PathBuf;
 use std::time::Instant;
