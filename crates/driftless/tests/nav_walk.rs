@@ -14,9 +14,12 @@
 //! **Filter.** `nav::session::run_session` with only the geometry given — lever arm
 //! (0, 0, −0.25) m, mounting identity — and the library's defaults
 //! ([`SessionConfig::new`] over [`FilterConfig::new`]: robust gate, gate recovery 3 s,
-//! alignment from 0.5 m/s, no aids), IMU noise from the `consumer` preset's numbers ([`walk_noise`]); no per-seed
-//! tuning. Variants: the same with the σ floor a moving antenna calls for (0.2 m, 0.4 m
-//! vertical); and, on the older settings (χ² gate 0.9999, heading from 0.8 m/s), **A** the
+//! alignment from 0.5 m/s, no aids, file σ), IMU noise from the `consumer` preset's
+//! numbers ([`walk_noise`]); no per-seed tuning. Variants: the same with the σ floor a
+//! moving antenna calls for (0.2 m, 0.4 m vertical: the hand-held setting) or 0.1 / 0.2 m;
+//! with the rotation-driven attitude noise of an unmodelled gyro axis coupling
+//! (`FilterConfig::gyro_coupling_sigma_rad`, 0.5 %, and 0.2 % on top of the hand-held
+//! floor); and, on the older settings (χ² gate 0.9999, heading from 0.8 m/s), **A** the
 //! χ² gate, **B** the fixes' σ floored at 0.1 m / 0.2 m
 //! (`SessionConfig::sigma_floor_m`), **C** no gate (`FilterConfig::gate = Gate::Off`),
 //! and diagnostics D–H.
@@ -44,37 +47,50 @@
 //!     not bad luck. Bar: ≥ 90 % of windows for each length. Reported alongside:
 //!     mean e_h, mean bound, and the mean of e_h²/(σ_N² + σ_E²) (≈ 1 when consistent).
 //!
-//! **Measured** (release, 2 cores; 1–3 s per variant for 20 seeds × 3 runs;
+//! **Measured** (release, 2 cores; 2–4 s per variant for 20 seeds × 3 runs;
 //! `cargo test --release -p driftless --test nav_walk measure_ -- --ignored --nocapture`,
-//! with `WALK_DIAGNOSTICS=1` for D–H):
+//! with `WALK_DIAGNOSTICS=1` for D–H, `WALK_SEEDS=1` for the per-seed figures):
 //!
 //! | variant | (a) rejected | (b) one-step / fix RMS (worst seed) | (c) 15 s: covered, mean e_h, mean 3σ_h, mean e²/σ² | (c) 30 s: covered, mean e_h, mean 3σ_h, mean e²/σ² |
 //! |---|---|---|---|---|
-//! | defaults | 0.00 % | 0.696 / 0.361 m = 1.93 (5.93) | 23.8 %, 21.2 m, 7.2 m, 122 | 18.3 %, 66.5 m, 23.8 m, 114 |
-//! | defaults + σ floor 0.2 / 0.4 m | 0.00 % | 0.677 / 0.362 m = 1.87 (7.31) | 88.8 %, 13.8 m, 17.0 m, 30.5 | 91.7 %, 43.0 m, 57.2 m, 35.3 |
-//! | A χ² gate | 79.2 % | 1.820 / 0.361 m = 5.04 (12.9) | 17.5 %, 152 m, 86.1 m, 81.3 | 33.3 %, 410 m, 338 m, 36.8 |
-//! | B σ floor 0.1 / 0.2 m | 5.12 % | 0.369 / 0.361 m = 1.02 (4.07) | 81.2 %, 20.1 m, 14.1 m, 20.9 | 83.3 %, 54.7 m, 52.7 m, 12.7 |
-//! | C no gate | 0 % | 0.472 / 0.361 m = 1.31 (2.06) | 6.2 %, 23.6 m, 5.5 m, 252 | 6.7 %, 82.4 m, 20.2 m, 219 |
-//! | D σ floor 0.3 / 0.3 m | 2.46 % | 0.490 / 0.364 m = 1.34 (5.77) | 92.5 %, 14.6 m, 21.0 m, 28.7 | 95.0 %, 36.6 m, 90.4 m, 10.5 |
-//! | E = A, antenna rigid on its lever arm | 3.59 % | 0.209 / 0.235 m = 0.89 (3.44) | 90.0 %, 7.0 m, 6.3 m, 24.6 | 91.7 %, 22.9 m, 24.2 m, 19.9 |
+//! | defaults | 0.00 % | 0.486 / 0.361 m = 1.35 (2.66) | 23.8 %, 18.2 m, 6.9 m, 103 | 21.7 %, 59.5 m, 22.8 m, 95.3 |
+//! | **defaults + σ floor 0.2 / 0.4 m** (hand-held setting) | **0.00 %** | **0.265 / 0.362 m = 0.73 (0.94)** | **97.5 %**, 6.6 m, 16.5 m, 1.9 | **98.3 %**, 21.1 m, 55.8 m, 1.6 |
+//! | defaults + σ floor 0.1 / 0.2 m | 0.00 % | 0.269 / 0.361 m = 0.75 (1.05) | 90.0 %, 6.8 m, 11.7 m, 4.1 | 88.3 %, 22.6 m, 38.2 m, 4.3 |
+//! | defaults + axis coupling 0.5 % | 0.00 % | 0.322 / 0.361 m = 0.89 (1.23) | 57.5 %, 28.5 m, 27.3 m, 13.2 | 71.7 %, 108 m, 151 m, 7.3 |
+//! | defaults + σ floor 0.2 / 0.4 m + coupling 0.2 % | 0.00 % | 0.244 / 0.362 m = 0.68 (0.88) | 98.8 %, 7.4 m, 27.5 m, 0.8 | 98.3 %, 22.7 m, 99.7 m, 0.6 |
+//! | A χ² gate | 78.8 % | 1.651 / 0.361 m = 4.57 (12.9) | 18.8 %, 145 m, 83.9 m, 78.4 | 31.7 %, 419 m, 339 m, 35.6 |
+//! | B σ floor 0.1 / 0.2 m | 1.56 % | 0.269 / 0.361 m = 0.74 (1.04) | 90.0 %, 6.6 m, 11.6 m, 3.9 | 90.0 %, 23.7 m, 41.6 m, 3.9 |
+//! | C no gate | 0 % | 0.471 / 0.361 m = 1.30 (2.06) | 8.8 %, 22.7 m, 5.5 m, 241 | 8.3 %, 76.2 m, 20.1 m, 194 |
+//! | D σ floor 0.3 / 0.3 m | 0.01 % | 0.278 / 0.364 m = 0.76 (0.98) | 100 %, 7.1 m, 20.5 m, 1.3 | 100 %, 23.8 m, 72.6 m, 1.1 |
+//! | E = A, antenna rigid on its lever arm | 0.86 % | 0.164 / 0.235 m = 0.70 (0.88) | 100 %, 0.8 m, 5.4 m, 0.2 | 100 %, 3.8 m, 18.8 m, 0.5 |
 //! | F = D, IMU noise terms only | 0.01 % | 0.276 / 0.364 m = 0.76 (0.98) | 100 %, 5.4 m, 20.6 m, 0.9 | 100 %, 17.9 m, 72.5 m, 0.8 |
-//! | G = D, true initial attitude and velocity | 2.25 % | 0.452 / 0.364 m = 1.24 (4.84) | 92.5 %, 13.4 m, 20.9 m, 27.1 | 95.0 %, 32.9 m, 88.7 m, 9.7 |
-//! | H = A, true initial attitude and velocity | 79.4 % | 1.981 / 0.361 m = 5.48 (16.8) | 18.8 %, 130 m, 83.3 m, 95.9 | 30.0 %, 470 m, 407 m, 35.1 |
+//! | G = D, true initial attitude and velocity | 0.01 % | 0.277 / 0.364 m = 0.76 (0.96) | 100 %, 5.8 m, 20.3 m, 1.0 | 100 %, 19.7 m, 70.6 m, 0.9 |
+//! | H = A, true initial attitude and velocity | 79.0 % | 1.892 / 0.361 m = 5.24 (16.8) | 21.2 %, 123 m, 80.3 m, 89.0 | 30.0 %, 464 m, 393 m, 33.1 |
 //!
-//! Reading: the defaults meet (a) only. Two things break them, each visible on its own:
-//! (1) the 1-cm formal σ against 0.28-m antenna motion: the filter believes every fix to
-//! a centimetre and is over-confident at every outage end (mean e²/σ² ≈ 120); a σ floor
-//! at the motion's size (the hand-held setting, row 2) brings (c) to 89 % / 92 %.
-//! (2) error terms the 21-state filter does not model — the consumer preset's cross-axis
-//! sensitivity, misalignment and g-sensitivity: with the IMU's noise terms only (F) every
-//! bar is met with margin (0.76×, 100 % / 100 %, e²/σ² ≈ 1), while with every term one
-//! or two seeds diverge (worst seed 5–6× the fixes' RMS), which keeps (b) above 1.2×.
-//! Estimating the fixes' σ from the innovations (an innovation-based adaptive R with a
-//! lag-one correlation allowance) was tried and made every figure worse: the innovations
-//! of a filter whose P is inconsistent carry the state's drift, the estimated R grows,
-//! the fixes lose weight and the drift grows further. So did a covariance reset after a
-//! run of inconsistent fixes (it fires every few seconds when R, not P, is too small).
-//! The asserting test below is therefore ignored until the defaults meet the bars.
+//! Reading: the session primes the gyro biases from the 10-s standstill of every seed
+//! (before the static test's gravity tolerance was widened to 1 m/s² — a consumer
+//! accelerometer's 20-mg turn-on bias moves |f̄| by up to ≈ 0.6 m/s² — two seeds were
+//! left with a 0.5-°/s gyro bias and diverged; that, not the unmodelled cross-axis
+//! terms, was what kept (b) above 1.2× with a floor: F ≈ D now). What remains is the 1-cm
+//! formal σ against 0.28-m correlated antenna motion: with the file's σ the defaults
+//! meet (a) only — the filter believes every fix to a centimetre and its σ at the outage
+//! ends is ~10× too small (mean e²/σ² ≈ 100). A floor at the motion's size (the
+//! hand-held setting, 0.2 / 0.4 m) meets every bar with margin and is consistent
+//! (e²/σ² 1.6–1.9); 0.1 m is not enough for 30-s outages. It is not the library default:
+//! on the real car drive (`tests/nav_drive.rs`, rigid roof antenna) a 0.2-m floor raises
+//! the full-RTK one-step RMS from 0.056 to 0.153 m (defaults) and from 0.062 to 0.497 m
+//! (published values; bar 0.10 m). The axis-coupling noise alone does not make the
+//! defaults consistent (57 % / 72 %) and on top of the floor it only trades a little
+//! accuracy for σ (e²/σ² ≈ 0.7); it stays off by default (on the tuned car preset it
+//! lengthens the six-outage mean from 27.85 m to 29.3 m at 0.1 %, 37.7 m at 0.5 %).
+//! Tried and worse, not kept: an innovation-based adaptive R (robust IAE with a lag-one
+//! correlation allowance) and a covariance reset after 8 inconsistent fixes (both with
+//! the unprimed seeds still in); an innovation-scaled σ floor (2 × the running RMS of the
+//! one-step innovations, 10-s time constant) meets the walk's bars (0.84×, 95 % / 98 %)
+//! but runs away on the car (full-RTK 0.27 m defaults, 0.95 m published values, tuned
+//! preset 0.16 m): weaker fixes let the prediction error grow, which raises the floor.
+//! The asserting test of the defaults is therefore ignored; the hand-held setting's
+//! bars are asserted by `walk_study_meets_the_bars_with_the_hand_held_floor`.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -158,6 +174,14 @@ enum Variant {
     /// The defaults with the σ floor a moving antenna calls for
     /// (`gnss.sigma_floor_m = 0.2`, vertical 0.4 m): the documented hand-held setting.
     MovingAntennaFloor,
+    /// The hand-held setting with a smaller floor, 0.1 m / 0.2 m.
+    SmallFloor,
+    /// The defaults with the rotation-driven attitude noise of an unmodelled gyro axis
+    /// coupling of 0.5 % (`FilterConfig::gyro_coupling_sigma_rad`; the preset's
+    /// misalignment is 4–9 mrad), file σ.
+    Coupling,
+    /// The hand-held setting plus a 0.2 % axis coupling.
+    FloorAndCoupling,
     Chi2Gate,
     SigmaFloor,
     NoGate,
@@ -176,9 +200,12 @@ enum Variant {
 }
 
 impl Variant {
-    const STUDY: [Variant; 5] = [
+    const STUDY: [Variant; 8] = [
         Variant::Default,
         Variant::MovingAntennaFloor,
+        Variant::SmallFloor,
+        Variant::Coupling,
+        Variant::FloorAndCoupling,
         Variant::Chi2Gate,
         Variant::SigmaFloor,
         Variant::NoGate,
@@ -195,6 +222,9 @@ impl Variant {
         match self {
             Variant::Default => "defaults (robust gate)",
             Variant::MovingAntennaFloor => "defaults + σ floor 0.2/0.4 m",
+            Variant::SmallFloor => "defaults + σ floor 0.1/0.2 m",
+            Variant::Coupling => "defaults + axis coupling 0.5 %",
+            Variant::FloorAndCoupling => "defaults + σ floor 0.2/0.4 m + coupling 0.2 %",
             Variant::Chi2Gate => "A χ² gate (chi2:0.9999)",
             Variant::SigmaFloor => "B σ floor 0.1/0.2 m",
             Variant::NoGate => "C no gate",
@@ -214,6 +244,19 @@ impl Variant {
                 c.sigma_floor_m = Some((0.2, 0.4));
                 return c;
             }
+            Variant::SmallFloor => {
+                c.sigma_floor_m = Some((0.1, 0.2));
+                return c;
+            }
+            Variant::Coupling => {
+                c.filter.gyro_coupling_sigma_rad = 5e-3;
+                return c;
+            }
+            Variant::FloorAndCoupling => {
+                c.sigma_floor_m = Some((0.2, 0.4));
+                c.filter.gyro_coupling_sigma_rad = 2e-3;
+                return c;
+            }
             _ => {}
         }
         c.min_speed_m_s = MIN_SPEED_M_S;
@@ -221,6 +264,9 @@ impl Variant {
         match self {
             Variant::Default
             | Variant::MovingAntennaFloor
+            | Variant::SmallFloor
+            | Variant::Coupling
+            | Variant::FloorAndCoupling
             | Variant::Chi2Gate
             | Variant::RigidAntenna
             | Variant::Chi2GateTrueHeading => {}
@@ -311,12 +357,16 @@ struct SeedFigures {
     ends_30: Vec<OutageEnd>,
     /// Heading error of the initial state against the truth, deg.
     init_yaw_err_deg: f64,
+    /// The gyro biases were primed from the static start.
+    primed: bool,
 }
 
 /// A forward run and its full-GNSS figure (Σ e² and count of the one-step prediction
 /// errors, `SessionResult::horizontal_rms_m`'s definition).
 struct Forward {
     run: ForwardRun,
+    /// The session primed the gyro biases from the static start.
+    primed: bool,
     t_init: f64,
     init_yaw_rad: f64,
     pred_ss: f64,
@@ -334,6 +384,7 @@ fn forward(imu: &ImuStream, sim: &Simulation, cfg: &SessionConfig, true_attitude
         let r = run_session(imu, g, cfg).expect("session");
         let (rms, n) = r.horizontal_rms_m.unwrap_or((0.0, 0));
         return Forward {
+            primed: r.primed_gyro_bias_rad_s.is_some(),
             t_init: r.init.nav.time_s,
             init_yaw_rad: Euler::from_dcm(&r.init.nav.q_bn.to_dcm()).yaw_rad,
             pred_ss: rms * rms * n as f64,
@@ -378,6 +429,7 @@ fn forward(imu: &ImuStream, sim: &Simulation, cfg: &SessionConfig, true_attitude
     }
     Forward {
         run,
+        primed: primed.is_some(),
         t_init: t0,
         init_yaw_rad: y,
         pred_ss,
@@ -453,6 +505,7 @@ fn seed_figures(sim: &Simulation, variant: Variant) -> SeedFigures {
     let dyaw = (full.init_yaw_rad - sim.truth.roll_pitch_yaw_rad[k][2]).to_degrees();
     SeedFigures {
         init_yaw_err_deg: (dyaw + 180.0).rem_euclid(360.0) - 180.0,
+        primed: full.primed,
         accepted: full.run.gnss_accepted,
         rejected: full.run.gnss_rejected,
         forced: full.run.gnss_forced,
@@ -478,6 +531,8 @@ struct Pooled {
     ends_30: (f64, f64, f64, f64),
     /// RMS initial heading error, deg.
     init_yaw_rms_deg: f64,
+    /// Seeds whose gyro biases were primed from the static start.
+    primed: usize,
 }
 
 impl Pooled {
@@ -513,6 +568,7 @@ fn pool(figs: &[SeedFigures]) -> Pooled {
         ends_15: ends(figs.iter().flat_map(|f| f.ends_15.clone()).collect()),
         ends_30: ends(figs.iter().flat_map(|f| f.ends_30.clone()).collect()),
         init_yaw_rms_deg: (sum(|f| f.init_yaw_err_deg.powi(2)) / figs.len() as f64).sqrt(),
+        primed: figs.iter().filter(|f| f.primed).count(),
     }
 }
 
@@ -541,6 +597,14 @@ fn study(variants: &[Variant]) -> Vec<Pooled> {
                 sims.iter().map(|s| seed_figures(s, v)).collect()
             };
             let p = pool(&figs);
+            if std::env::var_os("WALK_SEEDS").is_some() {
+                for (i, f) in figs.iter().enumerate() {
+                    let r = (f.pred_ss / f.pred_n as f64).sqrt() / (f.fix_ss / f.fix_n as f64).sqrt();
+                    let e15: Vec<String> = f.ends_15.iter().map(|e| format!("{:.0}/{:.0}", e.error_m, 3.0 * e.sigma_h_m)).collect();
+                    let e30: Vec<String> = f.ends_30.iter().map(|e| format!("{:.0}/{:.0}", e.error_m, 3.0 * e.sigma_h_m)).collect();
+                    eprintln!("  seed {} ratio {r:.2} yaw0 {:.1} rej {} | {} | {}", i + 1, f.init_yaw_err_deg, f.rejected, e15.join(" "), e30.join(" "));
+                }
+            }
             let row = |e: (f64, f64, f64, f64)| {
                 format!(
                     "{:.1} %, {:.2} m, {:.2} m, {:.1}",
@@ -760,23 +824,16 @@ fn walk_simulation_matches_the_scenario_and_the_filter_runs() {
     );
 }
 
-/// The study's bars under the default filter (module documentation).
-#[test]
-#[ignore = "bar not met yet: the defaults reject 0 % of the fixes (bar < 2 %), but with a \
-            1-cm formal σ against 0.28-m correlated antenna motion the filter is over-confident: \
-            one-step RMS 1.93× the fixes' error (bar 1.2×), outage ends inside 3σ in 24 % (15 s) \
-            and 18 % (30 s) of windows (bar 90 %); with a 0.2-m σ floor 1.87×, 89 % and 92 %; \
-            with the IMU's noise terms only every bar is met"]
-fn measure_walk_study_against_the_bars() {
-    let p = study(&[Variant::Default])[0];
+/// The study's bars (module documentation) on the pooled figures of one variant.
+fn assert_bars(p: &Pooled, what: &str) {
     assert!(
         p.rejected_share < 0.02,
-        "(a) {:.2} % of the fixes rejected by the gate (bar < 2 %)",
+        "{what}: (a) {:.2} % of the fixes rejected by the gate (bar < 2 %)",
         100.0 * p.rejected_share
     );
     assert!(
         p.ratio() <= 1.2,
-        "(b) one-step prediction RMS {:.3} m is {:.2}× the fixes' RMS error {:.3} m (bar ≤ 1.2×)",
+        "{what}: (b) one-step prediction RMS {:.3} m is {:.2}× the fixes' RMS error {:.3} m (bar ≤ 1.2×)",
         p.pred_rms_m,
         p.ratio(),
         p.fix_rms_m
@@ -784,8 +841,43 @@ fn measure_walk_study_against_the_bars() {
     for (len, e) in [(15, p.ends_15), (30, p.ends_30)] {
         assert!(
             e.0 >= 0.9,
-            "(c) {len}-s outages: {:.1} % of the ends within 3·√(σN² + σE²) (bar ≥ 90 %)",
+            "{what}: (c) {len}-s outages: {:.1} % of the ends within 3·√(σN² + σE²) (bar ≥ 90 %)",
             100.0 * e.0
+        );
+    }
+}
+
+/// The study's bars under the default filter (module documentation).
+#[test]
+#[ignore = "bar not met: with the file's 1-cm σ against 0.28-m correlated antenna motion the \
+            default filter is over-confident: one-step RMS 1.35× the fixes' error (bar 1.2×), \
+            outage ends inside 3σ in 24 % (15 s) and 22 % (30 s) of windows (bar 90 %); a \
+            default σ floor that fixes it (0.2 m) costs the car drive its full-RTK accuracy \
+            (0.06 → 0.15–0.50 m), so the floor is the hand-held setting, asserted below"]
+fn measure_walk_study_against_the_bars() {
+    let p = study(&[Variant::Default])[0];
+    assert_bars(&p, "defaults");
+}
+
+/// The hand-held setting (defaults + σ floor 0.2 m / 0.4 m) meets every bar of the study
+/// over the 20 seeds, and the session primes the gyro biases of every seed from the
+/// static start (a consumer accelerometer's turn-on bias moves |f̄| by up to ≈ 0.6 m/s²).
+#[test]
+fn walk_study_meets_the_bars_with_the_hand_held_floor() {
+    let p = study(&[Variant::MovingAntennaFloor])[0];
+    assert_eq!(
+        p.primed,
+        SEEDS.count(),
+        "seeds primed from the static start"
+    );
+    assert_bars(&p, "hand-held σ floor");
+    // Consistent, not merely conservative: the mean normalised squared error at the
+    // outage ends is of order 1 (≈ 1 for a consistent filter), not ≪ 1.
+    for (len, e) in [(15, p.ends_15), (30, p.ends_30)] {
+        assert!(
+            e.3 > 0.3 && e.3 < 5.0,
+            "{len}-s outages: mean e²/σ² {:.2} (a consistent filter gives ≈ 1)",
+            e.3
         );
     }
 }
@@ -797,7 +889,7 @@ fn measure_walk_study_against_the_bars() {
 fn measure_walk_filter_variants() {
     let clock = Instant::now();
     let rows = study(&Variant::STUDY);
-    assert_eq!(rows.len(), 5);
+    assert_eq!(rows.len(), Variant::STUDY.len());
     if std::env::var_os("WALK_DIAGNOSTICS").is_some() {
         study(&Variant::DIAGNOSTICS);
     }

@@ -94,6 +94,7 @@ pub struct Eskf {
     last_omega_b_rad_s: Vec3,
     q_c: [f64; N_STATES],
     neg_inv_tau: [f64; 12],
+    coupling_sigma_rad: f64,
     gate: Gate,
     symmetry_tol: f64,
 }
@@ -143,6 +144,7 @@ impl Eskf {
             last_omega_b_rad_s: [0.0; 3],
             q_c: cfg.q_c_diag(),
             neg_inv_tau: cfg.neg_inv_tau(),
+            coupling_sigma_rad: cfg.gyro_coupling_sigma_rad,
             gate: cfg.gate,
             symmetry_tol: cfg.symmetry_tol,
         };
@@ -275,7 +277,8 @@ impl Eskf {
         let inv = 1.0 / dt;
         let omega = comp.dtheta_rad.map(|v| v * inv);
         let f_b = comp.dvel_m_s.map(|v| v * inv);
-        let tr = Transition::new(&self.nav, omega, f_b, dt, &self.neg_inv_tau);
+        let tr = Transition::new(&self.nav, omega, f_b, dt, &self.neg_inv_tau)
+            .with_rotation_noise(self.coupling_sigma_rad);
         let prev = self.prev_inc.unwrap_or(comp);
         let next = mechanize(&self.nav, &prev, &comp);
         let ok = [next.lat_rad, next.lon_rad, next.height_m]

@@ -27,6 +27,24 @@
 //! δv̇ += C_bn w_a, φ̇ −= C_bn w_g with PSDs VRW², ARW² (m²/s³, rad²/s), isotropic, so
 //! G Q Gᵀ is *diagonal*: q_c = (0₃, VRW²·1₃, ARW²·1₃, 2σ²/T per sensor state).
 //!
+//! # Unmodelled gyro axis coupling (optional)
+//!
+//! A gyro whose axes are misaligned or cross-coupled measures ω̃ = (I + diag(s_g) + M)ω;
+//! the filter estimates s_g but has no state for the off-diagonal M. With the elements of
+//! M independent, zero-mean, of σ_c ([`FilterConfig::gyro_coupling_sigma_rad`]), the rate
+//! error Mω has the body-frame covariance σ_c² diag(|ω|² − ω_k²): none along a rotation
+//! about a body axis, σ_c²|ω|² across it. Its attitude error is coherent while the body
+//! keeps turning the same way (a yaw turn by θ tilts by up to σ_c·θ) and, resolved in the
+//! navigation frame, stays bounded (≤ 2|M| over whole turns). It is modelled as a random
+//! walk in the angle turned — each axis across the rotation gains σ_c² of variance per
+//! radian:
+//!
+//!   Q_φ,rot = σ_c² C_bn diag(|ω̂| − ω̂_k²/|ω̂|) C_bnᵀ   (rad²/s, added to Q_c's attitude block),
+//!
+//! so a 180° yaw turn adds a tilt σ of √π·σ_c ≈ 1.8σ_c against the coherent 2σ_c. This is
+//! an allowance in Q for an error without a state (derived here), not an estimate of M;
+//! oscillating rotation (hand sway) is counted at its full angle and so over-allowed.
+//!
 //! # Discretization
 //!
 //! Over the IMU interval Δt (5 ms at 200 Hz) Φ ≈ I + FΔt (first order: the neglected
@@ -231,6 +249,15 @@ pub struct FilterConfig {
     /// Standstill detection with ZUPT / ZARU ([`super::aids`]); `None` (default)
     /// disables it.
     pub standstill: Option<super::aids::StandstillConfig>,
+    /// σ_c of the gyro's axis coupling the filter has no state for — misalignment and
+    /// cross-axis sensitivity, the off-diagonal elements of M in ω̃ = (I + diag(s_g) + M)ω
+    /// — rad (1 % cross-axis = 0.01). It enters as rotation-driven attitude process noise
+    /// (module docs, [`Transition::with_rotation_noise`]). Default 0 (off): on the
+    /// simulated hand-held walk the fixes' σ floor alone makes the filter consistent, and
+    /// on the tuned car drive the term on top of its ×10 white noise lengthens the outage
+    /// errors; a noise model without such an allowance can set it from the data sheet's
+    /// cross-axis sensitivity.
+    pub gyro_coupling_sigma_rad: f64,
 }
 
 /// Innovation gating of a measurement update with m = 2 or 3 components, innovation y,
@@ -414,6 +441,7 @@ impl FilterConfig {
             symmetry_tol: 1e-9,
             nhc: None,
             standstill: None,
+            gyro_coupling_sigma_rad: 0.0,
         }
     }
 
@@ -468,6 +496,13 @@ impl FilterConfig {
             )));
         }
         self.gate.validate()?;
+        let c = self.gyro_coupling_sigma_rad;
+        if !(c.is_finite() && (0.0..=0.2).contains(&c)) {
+            return Err(NavError::Config(format!(
+                "gyro axis-coupling σ {c} rad must be finite and in [0, 0.2] \
+                 (0.01 = 1 % cross-axis sensitivity)"
+            )));
+        }
         if let Some(r) = self.gate_recovery_s
             && !(r.is_finite() && r > 0.0)
         {
@@ -605,9 +640,39 @@ pub struct Transition {
     pub phisg: M3,
     /// −Δt/T for the 12 sensor states.
     pub sensor: [f64; 12],
+    /// Rotation-driven attitude PSD block of the interval, NED, rad²/s (added to Q_c's
+    /// attitude block; [`Transition::with_rotation_noise`]). Zero unless set there.
+    pub att_rotation_q: M3,
+    /// Compensated mean angular rate ω̂_ib^b of the interval, rad/s.
+    pub rate_b_rad_s: Vec3,
 }
 
 impl Transition {
+    /// The same transition with the rotation-driven attitude process noise of an
+    /// unmodelled gyro axis coupling of σ `coupling_sigma_rad` = σ_c
+    /// ([`FilterConfig::gyro_coupling_sigma_rad`]; model in the module docs):
+    /// Q_φ,rot = σ_c² C_bn diag(|ω̂| − ω̂_k²/|ω̂|) C_bnᵀ, ω̂ = ω̂_ib^b the compensated mean
+    /// rate of the interval.
+    pub fn with_rotation_noise(mut self, coupling_sigma_rad: f64) -> Transition {
+        let w = &self.rate_b_rad_s;
+        let norm = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+        if !(coupling_sigma_rad > 0.0 && norm > 0.0 && self.dt_s > 0.0) {
+            return self;
+        }
+        let s2 = coupling_sigma_rad * coupling_sigma_rad;
+        let d: Vec3 = std::array::from_fn(|k| s2 * (norm - w[k] * w[k] / norm));
+        let c = sm(&self.vba, 1.0 / self.dt_s);
+        for i in 0..3 {
+            for j in i..3 {
+                let v =
+                    c[i][0] * d[0] * c[j][0] + c[i][1] * d[1] * c[j][1] + c[i][2] * d[2] * c[j][2];
+                self.att_rotation_q[i][j] = v;
+                self.att_rotation_q[j][i] = v;
+            }
+        }
+        self
+    }
+
     /// Build A = FΔt at the state `nav` (start of the interval) for the compensated
     /// mean angular rate `omega_ib_b_rad_s` and specific force `f_b_m_s2` over `dt_s`.
     /// `neg_inv_tau` from [`FilterConfig::neg_inv_tau`].
@@ -691,6 +756,8 @@ impl Transition {
             phibg: sm(&c_bn, -dt),
             phisg: sm(&phisg, dt),
             sensor: neg_inv_tau.map(|k| k * dt),
+            att_rotation_q: [[0.0; 3]; 3],
+            rate_b_rad_s: omega_ib_b_rad_s,
         }
     }
 
@@ -810,6 +877,11 @@ impl Transition {
         for i in 0..N_STATES {
             p[i][i] += half * q_c_diag[i];
         }
+        for i in 0..3 {
+            for j in 0..3 {
+                p[ATT + i][ATT + j] += half * self.att_rotation_q[i][j];
+            }
+        }
         let a = self.nav_rows();
         // Z = rows 0..9 of Φ P.
         let mut z = [[0.0; N_STATES]; 9];
@@ -864,6 +936,11 @@ impl Transition {
         }
         for i in 0..N_STATES {
             p[i][i] += half * q_c_diag[i];
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                p[ATT + i][ATT + j] += half * self.att_rotation_q[i][j];
+            }
         }
     }
 }
@@ -1067,6 +1144,80 @@ mod tests {
             ImuNoise::from_noise_model(&m, 1000.0, sc, sc),
             Err(NavError::Config(_))
         ));
+    }
+
+    /// The rotation-driven attitude noise: a yaw turn of a level body adds σ_c²|ω|Δt to
+    /// the north and east tilt and nothing to yaw, in whatever heading (the whole of P
+    /// changes by Φ(½Q_rotΔt)Φᵀ + ½Q_rotΔt); a roll about a body x axis pointing east adds
+    /// to north tilt and yaw; σ_c = 0 or no rotation adds nothing.
+    #[test]
+    fn rotation_noise_is_across_the_rotation() {
+        let c = cfg();
+        let (sigma, dt) = (0.01, 0.01);
+        let nav = |yaw: f64| NavState {
+            time_s: 0.0,
+            lat_rad: 0.5,
+            lon_rad: 1.0,
+            height_m: 100.0,
+            vel_ned_m_s: [1.0, 0.0, 0.0],
+            q_bn: Quat::from_rotation_vector([0.0, 0.0, yaw]),
+        };
+        let f = [0.0, 0.0, -9.8];
+        let added = |yaw: f64, w: Vec3, s: f64| {
+            let t = Transition::new(&nav(yaw), w, f, dt, &c.neg_inv_tau());
+            let mut p0 = [[0.0; N_STATES]; N_STATES];
+            for i in 0..N_STATES {
+                p0[i][i] = 1e-4;
+            }
+            let mut plain = p0;
+            t.propagate(&mut plain, &c.q_c_diag());
+            let mut noisy = p0;
+            t.with_rotation_noise(s)
+                .propagate(&mut noisy, &c.q_c_diag());
+            let mut d = [[0.0; N_STATES]; N_STATES];
+            for i in 0..N_STATES {
+                for j in 0..N_STATES {
+                    d[i][j] = noisy[i][j] - plain[i][j];
+                }
+            }
+            d
+        };
+        let yaw_rate = 0.5;
+        for yaw in [0.0, 0.7, -2.5] {
+            let w = [0.0, 0.0, yaw_rate];
+            let d = added(yaw, w, sigma);
+            // Expected: Φ(½Q_rot Δt)Φᵀ + ½Q_rot Δt with Q_rot = σ²|ω| diag(1, 1, 0) (NED).
+            let want = sigma * sigma * yaw_rate * dt;
+            let phi = Transition::new(&nav(yaw), w, f, dt, &c.neg_inv_tau()).phi_dense();
+            for i in 0..N_STATES {
+                for j in 0..N_STATES {
+                    let mut e = (0..2)
+                        .map(|k| 0.5 * want * phi[i][ATT + k] * phi[j][ATT + k])
+                        .sum::<f64>();
+                    if i == j && (ATT..ATT + 2).contains(&i) {
+                        e += 0.5 * want;
+                    }
+                    assert!(
+                        (d[i][j] - e).abs() < 1e-9 * want,
+                        "yaw {yaw}: P[{i}][{j}] changed by {}, expected {e}",
+                        d[i][j]
+                    );
+                }
+            }
+            assert!((d[ATT][ATT] - want).abs() < 1e-6 * want);
+            assert!(d[ATT + 2][ATT + 2].abs() < 1e-6 * want);
+        }
+        // Body x east (yaw 90°), rolling: north tilt and yaw get the noise, east does not.
+        let roll_rate = 0.2;
+        let d = added(std::f64::consts::FRAC_PI_2, [roll_rate, 0.0, 0.0], sigma);
+        let want = sigma * sigma * roll_rate * dt;
+        assert!((d[ATT][ATT] - want).abs() < 1e-9 * want);
+        assert!((d[ATT + 2][ATT + 2] - want).abs() < 1e-9 * want);
+        assert!(d[ATT + 1][ATT + 1].abs() < 1e-9 * want);
+        for (w, s) in [([0.0; 3], sigma), ([0.0, 0.0, yaw_rate], 0.0)] {
+            let d = added(0.3, w, s);
+            assert!(d.iter().flatten().all(|v| *v == 0.0));
+        }
     }
 
     /// The sparse propagation equals the dense Φ(P + ½QΔt)Φᵀ + ½QΔt.

@@ -206,6 +206,8 @@ pub struct ForwardRun {
     pub split_points: Vec<usize>,
     /// −1/T of the sensor states (to rebuild Φ).
     neg_inv_tau: [f64; 12],
+    /// σ_c of the unmodelled gyro axis coupling (to rebuild the interval's Q_c).
+    coupling_sigma_rad: f64,
 }
 
 impl ForwardRun {
@@ -218,13 +220,16 @@ impl ForwardRun {
         let prev = &self.epochs[k - 1];
         let c = &self.epochs[k].comp;
         let inv = 1.0 / c.dt_s;
-        Some(Transition::new(
-            &prev.nav,
-            c.dtheta_rad.map(|v| v * inv),
-            c.dvel_m_s.map(|v| v * inv),
-            c.dt_s,
-            &self.neg_inv_tau,
-        ))
+        Some(
+            Transition::new(
+                &prev.nav,
+                c.dtheta_rad.map(|v| v * inv),
+                c.dvel_m_s.map(|v| v * inv),
+                c.dt_s,
+                &self.neg_inv_tau,
+            )
+            .with_rotation_noise(self.coupling_sigma_rad),
+        )
     }
 
     /// The rejected measurements (gate).
@@ -631,6 +636,7 @@ pub fn run_forward_with(
             aids_inflated: 0,
             standstills: Vec::new(),
             neg_inv_tau: cfg.neg_inv_tau(),
+            coupling_sigma_rad: cfg.gyro_coupling_sigma_rad,
         },
     };
     let mut aids = AidState::new(cfg, nominal_dt, t0)?;
