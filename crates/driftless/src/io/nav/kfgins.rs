@@ -875,9 +875,7 @@ fn write_rows<const N: usize>(
     thread_local! {
         static SCRATCH: std::cell::Cell<Option<Box<LineBuf>>> = const { std::cell::Cell::new(None) };
     }
-    let mut buf = SCRATCH
-        .take()
-        .unwrap_or_else(|| Box::new(LineBuf::new()));
+    let mut buf = SCRATCH.take().unwrap_or_else(|| Box::new(LineBuf::new()));
     buf.pos = 0;
     let mut r = Ok(());
     for i in 0..n {
@@ -1114,7 +1112,19 @@ impl KfGinsRow {
         let [r, p, y] = times(self.roll_pitch_yaw_rad, R2D);
         let h = self.height_m;
         let (lat, lon) = (self.lat_rad * R2D, self.lon_rad * R2D);
-        [f64::from(gps_week), self.time_s, lat, lon, h, vn, ve, vd, r, p, y]
+        [
+            f64::from(gps_week),
+            self.time_s,
+            lat,
+            lon,
+            h,
+            vn,
+            ve,
+            vd,
+            r,
+            p,
+            y,
+        ]
     }
 
     /// The IMU-error line: time, gyro bias [deg/h], accel bias [mGal], scales [ppm].
@@ -1263,9 +1273,7 @@ fn append_std(
     first_row: usize,
 ) -> Result<usize, LogError> {
     let n = std_len(name, s)?;
-    write_rows(w, name, n, first_row, |i| {
-        std_row(s, i).std_values()
-    })?;
+    write_rows(w, name, n, first_row, |i| std_row(s, i).std_values())?;
     Ok(n)
 }
 
@@ -1519,13 +1527,14 @@ mod tests {
             match imu_row_fast(l) {
                 Some(v) => {
                     fast_rows += 1;
-                    assert_eq!(Some(v.map(f64::to_bits)), general.map(|g| g.map(f64::to_bits)), "{l}");
+                    assert_eq!(
+                        Some(v.map(f64::to_bits)),
+                        general.map(|g| g.map(f64::to_bits)),
+                        "{l}"
+                    );
                 }
                 // Not taken: the field reader decides (value or error).
-                None => assert!(
-                    !matches!(l, "1 2 3 4 5 6 7" | "1 2 3 4 5 6 1e-3"),
-                    "{l}"
-                ),
+                None => assert!(!matches!(l, "1 2 3 4 5 6 7" | "1 2 3 4 5 6 1e-3"), "{l}"),
             }
         }
         assert!(fast_rows >= 6);

@@ -28,9 +28,10 @@ pub use gpstime::{
     GpsTime, LEAP_SECONDS, ParseTimeBaseError, TimeBase, TimeBaseError, gps_minus_utc_s,
 };
 pub use kfgins::{
-    GnssReadOptions, KfGinsOutputWriter, KfGinsRow, ZeroSigma, read_kfgins_gnss, read_kfgins_gnss_file,
-    read_kfgins_imu, read_kfgins_imu_file, write_kfgins_gnss, write_kfgins_imu,
-    write_kfgins_imu_err, write_kfgins_nav, write_kfgins_outputs, write_kfgins_std,
+    GnssReadOptions, KfGinsOutputWriter, KfGinsRow, ZeroSigma, read_kfgins_gnss,
+    read_kfgins_gnss_file, read_kfgins_imu, read_kfgins_imu_file, write_kfgins_gnss,
+    write_kfgins_imu, write_kfgins_imu_err, write_kfgins_nav, write_kfgins_outputs,
+    write_kfgins_std,
 };
 pub use kfgins_config::{ImuNoise, KfGinsConfig, KfGinsConfigRaw};
 pub use rtklib::{
