@@ -55,10 +55,11 @@
 //! # Speed
 //!
 //! The IMU text is parsed in parallel blocks; the filter runs on the calling thread and
-//! hands blocks of settled records to a second thread that formats and writes the three
-//! files while the filter runs; record buffers are recycled between the two, and the
-//! records are dropped once written unless smoothing or [`KfGinsJobOptions::keep_records`]
-//! asks for them.
+//! hands blocks of settled records to a second thread that formats each record straight
+//! into the three files' buffers ([`KfGinsOutputWriter::append_row`]) and writes them
+//! while the filter runs; record buffers are recycled between the two, and the records
+//! are dropped once written unless smoothing or [`KfGinsJobOptions::keep_records`] asks
+//! for them.
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
@@ -80,7 +81,7 @@ use crate::eval::{EvalError, SelectOptions, SelectedOutage};
 use crate::io::LogError;
 use crate::io::nav::kfgins::{GnssReadOptions, SMOOTHED_SUFFIX, kfgins_heading_rad};
 use crate::io::nav::{
-    GnssFixes, ImuErrors, KfGinsConfig, KfGinsOutputWriter, NavSolution, NavStd,
+    GnssFixes, ImuErrors, KfGinsConfig, KfGinsOutputWriter, KfGinsRow, NavSolution, NavStd,
     read_kfgins_gnss_file, read_kfgins_imu_file,
 };
 
@@ -319,6 +320,33 @@ fn kfgins_rows<'a>(
     (sol, err, std)
 }
 
+/// One output row of a state, as [`kfgins_rows`] gives it: attitude as Euler angles of
+/// the attitude matrix (`Euler::from_dcm`), heading in KF-GINS's range.
+fn kfgins_row(n: &NavState, sensors: &SensorErrors, sd: &[f64; N_STATES]) -> KfGinsRow {
+    use super::filter::state::{ATT, BA, BG, POS, SA, SG, VEL};
+    let att = super::attitude::Euler::from_dcm(&n.q_bn.to_dcm());
+    let tri = |i: usize| [sd[i], sd[i + 1], sd[i + 2]];
+    KfGinsRow {
+        time_s: n.time_s,
+        lat_rad: n.lat_rad,
+        lon_rad: n.lon_rad,
+        height_m: n.height_m,
+        vel_ned_m_s: n.vel_ned_m_s,
+        roll_pitch_yaw_rad: [att.roll_rad, att.pitch_rad, kfgins_heading_rad(att.yaw_rad)],
+        gyro_bias_rad_s: sensors.gyro_bias_rad_s,
+        accel_bias_m_s2: sensors.accel_bias_m_s2,
+        gyro_scale: sensors.gyro_scale,
+        accel_scale: sensors.accel_scale,
+        std_pos_ned_m: tri(POS),
+        std_vel_ned_m_s: tri(VEL),
+        std_att_rad: tri(ATT),
+        std_gyro_bias_rad_s: tri(BG),
+        std_accel_bias_m_s2: tri(BA),
+        std_gyro_scale: tri(SG),
+        std_accel_scale: tri(SA),
+    }
+}
+
 /// Run the KF-GINS configuration at `config_path` with `opts` (module docs): read it and
 /// its IMU and GNSS files (paths as written, i.e. relative to the working directory, as
 /// KF-GINS), run the forward filter while writing KF-GINS's three output files into its
@@ -430,15 +458,8 @@ pub fn run_kf_gins_job(
     let (smoothed, smoothed_files) = if opts.smooth {
         let s = smooth(&run, &init, &cfg)?;
         let mut w = KfGinsOutputWriter::create_with_suffix(&k.output_dir, 0, SMOOTHED_SUFFIX)?;
-        let idx: Vec<usize> = output_rows(&run).collect();
-        for block in idx.chunks(OBSERVER_BLOCK) {
-            let (sol, err, std) = kfgins_rows(
-                block
-                    .iter()
-                    .map(|&i| &s.epochs[i])
-                    .map(|e| (&e.nav, &e.sensors, &e.std)),
-            );
-            w.append(&sol, &err, &std)?;
+        for e in output_rows(&run).map(|i| &s.epochs[i]) {
+            w.append_row(&kfgins_row(&e.nav, &e.sensors, &e.std))?;
         }
         (Some(s), Some(w.finish()?))
     } else {
@@ -480,9 +501,9 @@ fn forward_writing(
             let mut writer = KfGinsOutputWriter::create(out_dir, 0)?;
             let mut rows = 0;
             for mut block in rx {
-                let (sol, err, std) =
-                    kfgins_rows(block.iter().map(|e| (&e.nav, &e.sensors, &e.std)));
-                writer.append(&sol, &err, &std)?;
+                for e in &block {
+                    writer.append_row(&kfgins_row(&e.nav, &e.sensors, &e.std))?;
+                }
                 rows += block.len();
                 block.clear();
                 // The filter may have finished: then the buffer is simply dropped.

@@ -28,9 +28,10 @@ pub use gpstime::{
     GpsTime, LEAP_SECONDS, ParseTimeBaseError, TimeBase, TimeBaseError, gps_minus_utc_s,
 };
 pub use kfgins::{
-    GnssReadOptions, KfGinsOutputWriter, ZeroSigma, read_kfgins_gnss, read_kfgins_gnss_file,
-    read_kfgins_imu, read_kfgins_imu_file, write_kfgins_gnss, write_kfgins_imu,
-    write_kfgins_imu_err, write_kfgins_nav, write_kfgins_outputs, write_kfgins_std,
+    GnssReadOptions, KfGinsOutputWriter, KfGinsRow, ZeroSigma, read_kfgins_gnss,
+    read_kfgins_gnss_file, read_kfgins_imu, read_kfgins_imu_file, write_kfgins_gnss,
+    write_kfgins_imu, write_kfgins_imu_err, write_kfgins_nav, write_kfgins_outputs,
+    write_kfgins_std,
 };
 pub use kfgins_config::{ImuNoise, KfGinsConfig, KfGinsConfigRaw};
 pub use rtklib::{
@@ -47,6 +48,48 @@ pub(crate) fn read_file(path: &std::path::Path) -> Result<Vec<u8>, LogError> {
         path: path.display().to_string(),
         error,
     })
+}
+
+/// Block size of [`read_file_parallel`], bytes.
+const READ_BLOCK_BYTES: usize = 4 << 20;
+
+/// A large file read whole, in blocks read concurrently on the rayon pool (positioned
+/// reads): the copies out of the page cache and the page faults of the fresh buffer are
+/// shared by the cores instead of preceding all parsing on one. Same result as
+/// [`read_file`], which it falls back to for anything but a regular file of stable size
+/// (a file that grows or shrinks meanwhile is read again sequentially).
+pub(crate) fn read_file_parallel(path: &std::path::Path) -> Result<Vec<u8>, LogError> {
+    #[cfg(unix)]
+    {
+        use rayon::prelude::*;
+        use std::os::unix::fs::FileExt;
+        let io_err = |error| LogError::Io {
+            path: path.display().to_string(),
+            error,
+        };
+        let f = std::fs::File::open(path).map_err(io_err)?;
+        let meta = f.metadata().map_err(io_err)?;
+        let len = usize::try_from(meta.len()).unwrap_or(usize::MAX);
+        if !meta.is_file() || len < 2 * READ_BLOCK_BYTES || len == usize::MAX {
+            return read_file(path);
+        }
+        let mut buf = vec![0u8; len];
+        let read = buf
+            .par_chunks_mut(READ_BLOCK_BYTES)
+            .enumerate()
+            .try_for_each(|(k, chunk)| f.read_exact_at(chunk, (k * READ_BLOCK_BYTES) as u64));
+        // A shorter file now (an error), or a longer one (a byte past the length): the
+        // sequential reader, which reads to the end whatever it is.
+        let mut probe = [0u8; 1];
+        match read {
+            Ok(()) if f.read_at(&mut probe, len as u64).map_err(io_err)? == 0 => Ok(buf),
+            _ => read_file(path),
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        read_file(path)
+    }
 }
 
 /// A small text file (a configuration) read whole, refused when larger than `max_bytes`,
