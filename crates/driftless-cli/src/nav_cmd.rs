@@ -23,6 +23,10 @@ const PRESETS: &[(&str, &str)] = &[
         "drive_0708",
         include_str!("../../../examples/nav/drive_0708.toml"),
     ),
+    (
+        "hand-held",
+        include_str!("../../../examples/nav/hand-held.toml"),
+    ),
 ];
 
 /// Every configuration key as a flag ([`KEYS`]); given flags override the file.
