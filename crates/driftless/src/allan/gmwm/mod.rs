@@ -35,8 +35,10 @@
 //!    The lowest WIC wins.
 //! 6. **Intervals on the parameters** by a parametric bootstrap: B series of the data's
 //!    segment lengths are simulated from θ̂ (with [`crate::sim::noise::generate`]), their
-//!    WV computed and the model refitted; the interval is θ̂ ± z·sd* in the transformed
-//!    space (sd* the bootstrap standard deviation, z the normal quantile), mapped back.
+//!    WV computed and the model refitted by the same multi-start procedure as the data;
+//!    the interval is θ̂ ± z·sd* in the transformed space (sd* = 1.4826 × the median
+//!    absolute deviation of the replicates, a standard deviation robust to the few
+//!    replicates that drop a term; z the normal quantile), mapped back.
 //!    Their coverage over seeds is measured in `tests/gmwm.rs`.
 //!
 //! The result maps onto the noise-model file ([`noise_model`]): white → `white`,
@@ -509,9 +511,8 @@ pub fn gmwm_channels(
     channels
         .par_iter()
         .map(|(name, segs)| {
-            let (wavelet_variance, fit) = gmwm_segments(segs, tau0_s, cfg).map_err(|e| {
-                AllanError::Invalid(format!("GMWM of channel '{name}': {e}"))
-            })?;
+            let (wavelet_variance, fit) = gmwm_segments(segs, tau0_s, cfg)
+                .map_err(|e| AllanError::Invalid(format!("GMWM of channel '{name}': {e}")))?;
             Ok(GmwmChannel {
                 name: name.to_string(),
                 wavelet_variance,

@@ -86,10 +86,7 @@ impl Spec {
     /// exchangeable; the order makes replicates comparable).
     pub fn sort_gm(&self, th: &mut [f64]) {
         let first = self.n_params() - 2 * self.n_gm();
-        let mut pairs: Vec<(f64, f64)> = th[first..]
-            .chunks(2)
-            .map(|c| (c[0], c[1]))
-            .collect();
+        let mut pairs: Vec<(f64, f64)> = th[first..].chunks(2).map(|c| (c[0], c[1])).collect();
         pairs.sort_by(|a, b| a.1.total_cmp(&b.1));
         for (k, (s, t)) in pairs.into_iter().enumerate() {
             th[first + 2 * k] = s;
@@ -358,13 +355,27 @@ impl Problem<'_> {
     }
 }
 
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
 /// Weighted least-squares amplitude of one column alone.
 fn single_ls(col: &[f64], y: &[f64], w: &[f64]) -> f64 {
     let (num, den) = col
         .iter()
         .zip(y)
         .zip(w)
-        .fold((0.0, 0.0), |(n, d), ((c, y), w)| (n + w * c * y, d + w * c * c));
+        .fold((0.0, 0.0), |(n, d), ((c, y), w)| {
+            (n + w * c * y, d + w * c * c)
+        });
     if den > 0.0 { (num / den).max(0.0) } else { 0.0 }
 }
 
@@ -548,28 +559,38 @@ pub fn fit_gmwm(wv: &WaveletVariance, cfg: &GmwmConfig) -> Result<GmwmFit, Allan
     let replicates: Vec<Vec<f64>> = (0..cfg.bootstrap)
         .into_par_iter()
         .filter_map(|b| {
-            let mut st = cfg.seed.wrapping_add(b as u64);
-            let seed = splitmix64(&mut st);
+            // Replicate b of seed s: unrelated streams for every (s, b), so fits with
+            // neighbouring seeds do not share replicates.
+            let mut st = cfg.seed ^ (b as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            let seed = splitmix64(&mut st) ^ splitmix64(&mut st).rotate_left(17);
             let segs = simulate(&params, &wv.segment_samples, wv.tau0_s, seed).ok()?;
             let refs: Vec<&[f64]> = segs.iter().map(Vec::as_slice).collect();
             let (nu_b, _) = raw_wavelet_variance(&refs, wv.tau0_s, &wv.m);
             if nu_b.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
                 return None;
             }
-            let pb = Problem { nu: &nu_b, ..prob.clone_shape() };
-            let (tb, jb) = pb.refine(spec, th.clone(), REWEIGHT_ROUNDS);
+            // The replicate goes through the same estimator as the data (multi-start,
+            // reweighting), so optimiser-dependent spread is reproduced too.
+            let pb = Problem {
+                nu: &nu_b,
+                ..prob.clone_shape()
+            };
+            let (tb, jb) = pb.fit(spec);
             (jb.is_finite() && tb.iter().all(|v| v.is_finite())).then_some(tb)
         })
         .collect();
     let z = normal_quantile(0.5 + cfg.confidence / 2.0);
+    // Robust spread: 1.4826 × the median absolute deviation, so the few replicates whose
+    // fit drops a term (ln amplitude² at its lower bound) or swaps two Gauss–Markov
+    // terms do not dominate the interval.
     let sd: Vec<f64> = (0..th.len())
         .map(|i| {
-            let n = replicates.len() as f64;
-            if n < 2.0 {
+            if replicates.len() < 2 {
                 return 0.0;
             }
-            let mean = replicates.iter().map(|r| r[i]).sum::<f64>() / n;
-            (replicates.iter().map(|r| (r[i] - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+            let v: Vec<f64> = replicates.iter().map(|r| r[i]).collect();
+            let med = median(v.clone());
+            1.482_6 * median(v.iter().map(|x| (x - med).abs()).collect())
         })
         .collect();
     let mut terms = Vec::with_capacity(spec.procs.len());
@@ -659,12 +680,19 @@ mod tests {
     #[test]
     fn nnls_recovers_a_nonnegative_combination() {
         let cols = vec![vec![1.0, 0.5, 0.25, 0.125], vec![0.1, 0.2, 0.4, 0.8]];
-        let y: Vec<f64> = (0..4).map(|j| 3.0 * cols[0][j] + 2.0 * cols[1][j]).collect();
+        let y: Vec<f64> = (0..4)
+            .map(|j| 3.0 * cols[0][j] + 2.0 * cols[1][j])
+            .collect();
         let (a, cost) = nnls_cd(&cols, &y, &[1.0; 4]);
-        assert!((a[0] - 3.0).abs() < 1e-6 && (a[1] - 2.0).abs() < 1e-6, "{a:?}");
+        assert!(
+            (a[0] - 3.0).abs() < 1e-6 && (a[1] - 2.0).abs() < 1e-6,
+            "{a:?}"
+        );
         assert!(cost < 1e-10);
         // A target that wants a negative second coefficient gets zero there.
-        let y: Vec<f64> = (0..4).map(|j| 3.0 * cols[0][j] - 2.0 * cols[1][j]).collect();
+        let y: Vec<f64> = (0..4)
+            .map(|j| 3.0 * cols[0][j] - 2.0 * cols[1][j])
+            .collect();
         let (a, _) = nnls_cd(&cols, &y, &[1.0; 4]);
         assert_eq!(a[1], 0.0);
     }
