@@ -15,54 +15,14 @@ use driftless::allan::gmwm::{
 use driftless::allan::noise_model::NoiseModel;
 use driftless::allan::taus::TauSpec;
 use driftless::io::Quantity;
-use driftless::sim::noise::{GaussMarkovConfig, StaticNoiseConfig, generate};
 use rayon::prelude::*;
 
 const TAU0: f64 = 0.01;
 
-fn cfg_of(params: &[ProcessParams], n: usize) -> Vec<StaticNoiseConfig> {
-    // One simulator config per Gauss–Markov term beyond the first (the simulator holds
-    // one); the other processes go into the first.
-    let base = StaticNoiseConfig {
-        sample_rate_hz: 1.0 / TAU0,
-        duration_s: n as f64 * TAU0,
-        ..StaticNoiseConfig::default()
-    };
-    let mut main = base.clone();
-    let mut out = Vec::new();
-    for p in params {
-        match *p {
-            ProcessParams::Quantization { q } => main.quantization = q,
-            ProcessParams::White { n } => main.white = n,
-            ProcessParams::RandomWalk { k } => main.rate_random_walk = k,
-            ProcessParams::Drift { r } => main.rate_ramp = r,
-            ProcessParams::GaussMarkov { sigma, tau_c_s } => {
-                let gm = Some(GaussMarkovConfig { sigma, tau_c_s });
-                if main.gauss_markov.is_none() {
-                    main.gauss_markov = gm;
-                } else {
-                    out.push(StaticNoiseConfig {
-                        gauss_markov: gm,
-                        ..base.clone()
-                    });
-                }
-            }
-        }
-    }
-    out.insert(0, main);
-    out
-}
-
 fn simulate(params: &[ProcessParams], n: usize, seed: u64) -> Vec<f64> {
-    let cfgs = cfg_of(params, n);
-    let mut y = vec![0.0; n];
-    for (i, c) in cfgs.iter().enumerate() {
-        let z = generate(c, seed.wrapping_mul(7919).wrapping_add(i as u64)).unwrap();
-        for (a, b) in y.iter_mut().zip(z) {
-            *a += b;
-        }
-    }
-    y
+    driftless::allan::gmwm::simulate(params, &[n], TAU0, seed.wrapping_mul(7919))
+        .unwrap()
+        .remove(0)
 }
 
 /// Mean of the WV estimate over `reps` realisations against the closed form at every
@@ -524,7 +484,11 @@ fn read_run(run: u32) -> driftless::io::ImuLog {
         .unwrap_or_else(|e| panic!("gzip -dc {}: {e}", src.display()));
     assert!(out.status.success(), "gzip -dc {} failed", src.display());
     std::fs::write(&dst, out.stdout).unwrap();
-    let log = driftless::io::read_log_file(&dst, &Default::default()).unwrap();
+    let opts = driftless::io::TextOptions {
+        time_column: Some(driftless::io::ColumnRef::Index(1)),
+        ..Default::default()
+    };
+    let log = driftless::io::read_log_file(&dst, &opts).unwrap();
     std::fs::remove_file(&dst).ok();
     log
 }
@@ -658,4 +622,54 @@ fn measure_gmwm_and_allan_fit_predict_the_other_run() {
             );
         }
     }
+}
+
+/// A Gauss–Markov term of a few samples' correlation time goes into the file's white
+/// density (N² += 2σ²T); the slowest one stays the file's Gauss–Markov term.
+#[test]
+fn short_gauss_markov_terms_fold_into_white_noise_in_the_file() {
+    use driftless::allan::fit::Term;
+    use driftless::allan::gmwm::GmwmTerm;
+    let t = |v: f64| Term {
+        value: v,
+        lo: 0.9 * v,
+        hi: 1.1 * v,
+    };
+    let fit = GmwmFit {
+        model: "WN+2GM".into(),
+        terms: vec![
+            GmwmTerm {
+                process: Process::White,
+                value: t(1e-3),
+                tau_c_s: None,
+            },
+            GmwmTerm {
+                process: Process::GaussMarkov,
+                value: t(6e-3),
+                tau_c_s: Some(t(0.005)),
+            },
+            GmwmTerm {
+                process: Process::GaussMarkov,
+                value: t(3e-4),
+                tau_c_s: Some(t(100.0)),
+            },
+        ],
+        criterion: String::new(),
+        objective: 10.0,
+        wic: 20.0,
+        n_params: 5,
+        n_scales: 18,
+        candidates: Vec::new(),
+        confidence: 0.683,
+        bootstrap: 0,
+        tau0_s: TAU0,
+        rms_log10_residual: 0.0,
+    };
+    let nf = fit.to_noise_fit();
+    let n = nf.white.unwrap();
+    let want = (1e-6f64 + 2.0 * 36e-6 * 0.005).sqrt();
+    assert!((n.value / want - 1.0).abs() < 1e-12, "{n:?}");
+    assert!(n.lo < n.value && n.value < n.hi);
+    assert_eq!(nf.gauss_markov.unwrap().tau_c_s.value, 100.0);
+    assert!((nf.chi2_reduced - 10.0 / 13.0).abs() < 1e-12);
 }

@@ -62,7 +62,7 @@ use super::phase::frequency_to_phase;
 use super::{AllanError, Estimator, ci, estimators};
 use crate::io::Quantity;
 
-pub use solve::fit_gmwm;
+pub use solve::{fit_gmwm, simulate};
 
 /// Largest number of Gauss–Markov terms a GMWM model may hold.
 pub const MAX_GAUSS_MARKOV: usize = 4;
@@ -414,6 +414,10 @@ pub struct GmwmFit {
     pub rms_log10_residual: f64,
 }
 
+/// Gauss–Markov terms (other than the slowest) with T below this many sample intervals
+/// are white noise to a filter and go into the file's `white` term.
+pub const WHITE_FOLD_SAMPLES: f64 = 10.0;
+
 /// The criterion as reported.
 pub const CRITERION: &str = "WIC = J(theta) + 2p (GMM objective with the diagonal eta3 \
                               weights plus twice the number of parameters)";
@@ -439,19 +443,51 @@ impl GmwmFit {
     /// `quantization`, random walk → `rate_random_walk`, drift → `rate_ramp`, the
     /// Gauss–Markov term of longest correlation time → `gauss_markov` (the complete model
     /// is kept in [`ChannelNoise::gmwm`]). `chi2_reduced` is J/(J_scales − p).
+    ///
+    /// Any other Gauss–Markov term with T < [`WHITE_FOLD_SAMPLES`]·τ0 is, for a filter
+    /// or simulator, white noise: it is folded into `white` with its low-frequency
+    /// density N² = 2σ_b²T (the two-sided PSD at f = 0; Gelb 1974, §4.4), so that a
+    /// model whose "white" part the GMWM found correlated over a few samples still
+    /// carries it. The folded interval adds the squared bounds (errors treated as fully
+    /// correlated, i.e. the wider choice).
     pub fn to_noise_fit(&self) -> NoiseFit {
         let find = |p: Process| self.terms.iter().find(|t| t.process == p).map(|t| t.value);
-        let gauss_markov = self
+        let gms: Vec<(Term, Term)> = self
             .terms
             .iter()
             .filter(|t| t.process == Process::GaussMarkov)
             .filter_map(|t| t.tau_c_s.map(|tc| (t.value, tc)))
-            .max_by(|a, b| a.1.value.total_cmp(&b.1.value))
-            .map(|(sigma, tau_c_s)| GaussMarkovTerm { sigma, tau_c_s });
+            .collect();
+        let slowest = gms
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.1.value.total_cmp(&b.1.1.value))
+            .map(|(i, _)| i);
+        let gauss_markov = slowest.map(|i| GaussMarkovTerm {
+            sigma: gms[i].0,
+            tau_c_s: gms[i].1,
+        });
+        let mut white = find(Process::White);
+        for (i, (sigma, tc)) in gms.iter().enumerate() {
+            if Some(i) == slowest || tc.value >= WHITE_FOLD_SAMPLES * self.tau0_s {
+                continue;
+            }
+            let d2 = |s: f64, t: f64| 2.0 * s * s * t;
+            let w = white.unwrap_or(Term {
+                value: 0.0,
+                lo: 0.0,
+                hi: 0.0,
+            });
+            white = Some(Term {
+                value: (w.value.powi(2) + d2(sigma.value, tc.value)).sqrt(),
+                lo: (w.lo.powi(2) + d2(sigma.lo, tc.lo)).sqrt(),
+                hi: (w.hi.powi(2) + d2(sigma.hi, tc.hi)).sqrt(),
+            });
+        }
         let dof = self.n_scales.saturating_sub(self.n_params).max(1);
         NoiseFit {
             quantization: find(Process::Quantization),
-            white: find(Process::White),
+            white,
             bias_instability: None,
             rate_random_walk: find(Process::RandomWalk),
             rate_ramp: find(Process::Drift),

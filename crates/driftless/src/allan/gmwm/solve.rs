@@ -440,8 +440,10 @@ fn solve_linear(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
 }
 
 /// Simulate one realisation of `params` with the given segment lengths (independent
-/// segments), using the product's noise simulator.
-pub(crate) fn simulate(
+/// segments, rate samples at `tau0_s`), using the product's noise simulator
+/// ([`crate::sim::noise::generate`]; quantization noise is uniform there, every other
+/// process Gaussian). Reproducible from `seed`.
+pub fn simulate(
     params: &[ProcessParams],
     segment_samples: &[usize],
     tau0_s: f64,
