@@ -391,7 +391,7 @@ fn nnls_cd(cols: &[Vec<f64>], y: &[f64], w: &[f64]) -> (Vec<f64>, f64) {
     for _ in 0..300 {
         let mut change = 0.0f64;
         for (i, c) in cols.iter().enumerate() {
-            if !(den[i] > 0.0) {
+            if den[i].is_nan() || den[i] <= 0.0 {
                 continue;
             }
             let num: f64 = c.iter().zip(&r).zip(w).map(|((c, r), w)| w * c * r).sum();
@@ -423,12 +423,14 @@ fn solve_linear(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
         }
         a.swap(col, piv);
         b.swap(col, piv);
-        for row in col + 1..n {
-            let f = a[row][col] / a[col][col];
-            for k in col..n {
-                a[row][k] -= f * a[col][k];
+        let (top, bottom) = a.split_at_mut(col + 1);
+        let pivot = &top[col];
+        for (k, row) in bottom.iter_mut().enumerate() {
+            let f = row[col] / pivot[col];
+            for (x, p) in row[col..].iter_mut().zip(&pivot[col..]) {
+                *x -= f * p;
             }
-            b[row] -= f * b[col];
+            b[col + 1 + k] -= f * b[col];
         }
     }
     let mut x = vec![0.0; n];

@@ -113,7 +113,7 @@ mod tests {
     #[test]
     fn gauss_markov_form_matches_the_autocovariance_sum() {
         let tau0 = 0.01;
-        for &t in &[0.003, 0.05, 1.0, 30.0, 1e4, 1e8] {
+        for &t in &[0.003f64, 0.05, 1.0, 30.0, 1e4, 1e8] {
             let phi = (-tau0 / t).exp();
             for &m in &[1usize, 2, 3, 8, 64, 200] {
                 let want = 0.5 * ar1_avar_direct(2.0, phi, m);
@@ -140,13 +140,13 @@ mod tests {
     fn limits_of_the_gauss_markov_form() {
         let tau0 = 0.01;
         // T ≫ τ: a random walk of step variance σ_b²(1 − φ²) ≈ 2σ_b²τ0/T.
-        let (s, t) = (1.0, 1e7);
+        let (s, t) = (1.0f64, 1e7f64);
         let k = (2.0 * s * s / t).sqrt();
         let m = 100.0;
         let rw = wv_random_walk(k, m, tau0);
         assert!((wv_gauss_markov(s, t, m, tau0) / rw - 1.0).abs() < 1e-4);
         // T ≪ τ: white noise of density N² = 2σ_b²T (two-sided PSD at f = 0).
-        let t = 0.5;
+        let t = 0.5f64;
         let m = 1e6;
         let n = (2.0 * s * s * t).sqrt();
         let w = wv_white(n, m, tau0);
