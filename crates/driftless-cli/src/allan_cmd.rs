@@ -6,6 +6,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use driftless::allan::analysis::{AnalysisConfig, ChannelResult, analyse_channels};
 use driftless::allan::fit::FitConfig;
+use driftless::allan::gmwm::{self, GmwmChannel, GmwmConfig};
 use driftless::allan::lines::{self, ChannelLines, LineConfig, SpectralLine};
 use driftless::allan::noise_model::NoiseModel;
 use driftless::allan::taus::TauSpec;
@@ -22,6 +23,16 @@ pub enum DataTypeArg {
     Freq,
     /// Integrated values (angle, velocity, time error).
     Phase,
+}
+
+/// Which estimator produces the noise model.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// IEEE 952 term fit to the overlapping Allan variance.
+    Allan,
+    /// Generalized method of wavelet moments: Haar wavelet variance, GMM fit of a sum of
+    /// processes (white, quantization, random walk, drift, Gauss-Markov), WIC selection.
+    Gmwm,
 }
 
 #[derive(Args, Debug)]
@@ -52,10 +63,16 @@ pub struct AllanArgs {
     /// slightly wider intervals (the EDF accounts for it). Only with --estimator oadev.
     #[arg(long)]
     pub fast: bool,
+    /// Noise-model estimator: allan (IEEE 952 fit to the Allan variance) or gmwm
+    /// (wavelet-variance GMM with model selection).
+    #[arg(long, value_enum, default_value = "allan")]
+    pub method: MethodArg,
     /// Noise terms to fit, comma-separated from q (quantization), n (white: ARW/VRW),
     /// b (bias instability), k (rate random walk), r (rate ramp), gm (one Gauss-Markov).
-    #[arg(long, default_value = "q,n,b,k,r", value_name = "LIST")]
-    pub terms: String,
+    /// Default q,n,b,k,r. With --method gmwm the candidates of the model selection:
+    /// q, n, k, r, gm (up to three Gauss-Markov terms) or gm1..gm4; default q,n,k,r,gm.
+    #[arg(long, value_name = "LIST")]
+    pub terms: Option<String>,
     /// Skip the noise-term fit.
     #[arg(long)]
     pub no_fit: bool,
@@ -82,6 +99,8 @@ pub struct AllanOutput {
     pub quantities: Vec<Quantity>,
     pub units: Vec<String>,
     pub noise: Option<NoiseModel>,
+    /// The GMWM per channel (wavelet variance and fit) when `--method gmwm`.
+    pub gmwm: Vec<GmwmChannel>,
     /// Whether the record suits the analysis: not static, too short for a fitted term
     /// (see `driftless::allan::checks`).
     pub warnings: Vec<String>,
@@ -111,11 +130,39 @@ pub fn analysis_config(a: &AllanArgs) -> Result<AnalysisConfig> {
     })
 }
 
-/// Analyse every non-temperature channel of `log` and (optionally) fit noise terms.
+/// Which noise model to fit.
+#[derive(Clone, Debug)]
+pub enum NoiseMethod {
+    /// IEEE 952 term fit to the OADEV curve.
+    Allan(FitConfig),
+    /// GMWM.
+    Gmwm(GmwmConfig),
+}
+
+/// Analyse every non-temperature channel of `log` and (optionally) fit noise terms
+/// with the Allan fit.
 pub fn analyse_log(
     log: &ImuLog,
     cfg: &AnalysisConfig,
     fit: Option<&FitConfig>,
+    scale: Option<f64>,
+    remove_lines: bool,
+) -> Result<AllanOutput> {
+    analyse_log_with(
+        log,
+        cfg,
+        fit.cloned().map(NoiseMethod::Allan).as_ref(),
+        scale,
+        remove_lines,
+    )
+}
+
+/// Analyse every non-temperature channel of `log` and (optionally) fit a noise model
+/// by `method`.
+pub fn analyse_log_with(
+    log: &ImuLog,
+    cfg: &AnalysisConfig,
+    method: Option<&NoiseMethod>,
     scale: Option<f64>,
     remove_lines: bool,
 ) -> Result<AllanOutput> {
@@ -213,7 +260,7 @@ pub fn analyse_log(
         ..cfg.clone()
     };
     // The line-free OADEV curves, and the same τ on the data as they are, for the σ shift.
-    let clean_curves = if any_lines && fit.is_some() {
+    let clean_curves = if any_lines && method.is_some() {
         Some(analyse_channels(&fit_inputs, log.tau0_s, &oadev_cfg)?)
     } else {
         None
@@ -242,9 +289,15 @@ pub fn analyse_log(
             });
         }
     }
-    let noise = match fit {
+    let mut gmwm_channels = Vec::new();
+    let noise = match method {
         None => None,
-        Some(fc) => {
+        Some(NoiseMethod::Gmwm(gc)) => {
+            gmwm_channels = gmwm::gmwm_channels(&fit_inputs, log.tau0_s, gc)
+                .with_context(|| format!("GMWM of {}", log.source))?;
+            Some(gmwm::noise_model(&log.source, &gmwm_channels, &quantities)?)
+        }
+        Some(NoiseMethod::Allan(fc)) => {
             // The noise model is an Allan-variance model: fit an OADEV curve (of the
             // line-free data). Reuse the requested one when it is that curve, otherwise
             // compute one on a log grid.
@@ -317,6 +370,7 @@ pub fn analyse_log(
         quantities,
         units,
         noise,
+        gmwm: gmwm_channels,
         warnings,
         lines: lines_out,
     })
@@ -327,7 +381,7 @@ pub fn run(a: AllanArgs) -> Result<()> {
     let fit = if a.no_fit {
         None
     } else {
-        Some(a.terms.parse::<FitConfig>().context("--terms")?)
+        Some(noise_method(&a)?)
     };
     let log = read_with_progress(&a.input, &a.file, a.json)?;
     for g in &log.gaps {
@@ -353,7 +407,7 @@ pub fn run(a: AllanArgs) -> Result<()> {
             log.len()
         ),
     );
-    let out = analyse_log(&log, &cfg, fit.as_ref(), a.scale, !a.keep_lines)?;
+    let out = analyse_log_with(&log, &cfg, fit.as_ref(), a.scale, !a.keep_lines)?;
     spinner.finish_and_clear();
     for w in &out.warnings {
         eprintln!("warning: {w}");
@@ -383,6 +437,32 @@ pub fn run(a: AllanArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The noise-model method and its term selection from `--method`, `--terms` and
+/// `--confidence`.
+pub fn noise_method(a: &AllanArgs) -> Result<NoiseMethod> {
+    Ok(match a.method {
+        MethodArg::Allan => NoiseMethod::Allan(
+            a.terms
+                .as_deref()
+                .unwrap_or("q,n,b,k,r")
+                .parse::<FitConfig>()
+                .context("--terms")?,
+        ),
+        MethodArg::Gmwm => {
+            let terms = match &a.terms {
+                Some(t) => t
+                    .parse::<GmwmConfig>()
+                    .context("--terms (with --method gmwm)")?,
+                None => GmwmConfig::default(),
+            };
+            NoiseMethod::Gmwm(GmwmConfig {
+                confidence: a.confidence,
+                ..terms
+            })
+        }
+    })
 }
 
 /// Read a log, with a spinner for big files.
@@ -424,12 +504,16 @@ pub fn json_output(out: &AllanOutput) -> serde_json::Value {
         Some(m) => serde_json::to_value(m).unwrap_or(serde_json::Value::Null),
         None => serde_json::Value::Null,
     };
-    serde_json::json!({
+    let mut doc = serde_json::json!({
         "channels": channels,
         "noise": noise,
         "warnings": out.warnings,
         "lines": out.lines,
-    })
+    });
+    if !out.gmwm.is_empty() {
+        doc["gmwm"] = serde_json::to_value(&out.gmwm).unwrap_or(serde_json::Value::Null);
+    }
+    doc
 }
 
 fn human_output(out: &AllanOutput, log: &ImuLog, file: &Path) -> String {
@@ -468,8 +552,37 @@ fn human_output(out: &AllanOutput, log: &ImuLog, file: &Path) -> String {
         s.push_str(&t.render());
         s.push('\n');
     }
+    for g in &out.gmwm {
+        let w = &g.wavelet_variance;
+        s.push_str(&format!(
+            "{} — Haar wavelet variance, {:.1} % confidence (eta3 EDF)\n",
+            g.name,
+            100.0 * w.confidence
+        ));
+        let mut t = Table::new(["tau [s]", "edf", "wv_lo", "wv", "wv_hi", "model"]);
+        for j in 0..w.m.len() {
+            t.row(vec![
+                sci(w.tau_s[j]),
+                sci(w.edf[j]),
+                sci(w.wv_lo[j]),
+                sci(w.wv[j]),
+                sci(w.wv_hi[j]),
+                sci(g.fit.model_wv(w.tau_s[j])),
+            ]);
+        }
+        s.push_str(&t.render());
+        s.push('\n');
+    }
     if let Some(m) = &out.noise {
-        s.push_str(&m.human_table());
+        if out.gmwm.is_empty() {
+            s.push_str(&m.human_table());
+        } else {
+            s.push_str(&format!(
+                "GMWM noise models (selection by {}):\n",
+                gmwm::CRITERION
+            ));
+            s.push_str(&gmwm::human_table(m));
+        }
     }
     s
 }

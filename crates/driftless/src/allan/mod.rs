@@ -11,6 +11,7 @@ pub mod checks;
 pub mod ci;
 pub mod estimators;
 pub mod fit;
+pub mod gmwm;
 pub mod lines;
 pub mod noise_model;
 pub mod phase;

@@ -318,6 +318,11 @@ pub struct ChannelNoise {
     pub display: Vec<DisplayValue>,
     /// Per-sample discrete parameters at the model's sample rate (informational).
     pub discrete: DiscreteNoise,
+    /// The complete GMWM model when the channel was fitted by the GMWM (every
+    /// Gauss–Markov term, the selection criterion and the candidates); `fit` then holds
+    /// its mapping onto the IEEE 952 terms. Absent in files of the Allan fit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gmwm: Option<super::gmwm::GmwmFit>,
 }
 
 impl ChannelNoise {
@@ -331,6 +336,7 @@ impl ChannelNoise {
             discrete: discrete_noise(&fit, sample_rate_hz),
             fit,
             slope_readings: None,
+            gmwm: None,
         }
     }
 }
