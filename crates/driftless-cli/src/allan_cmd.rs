@@ -220,74 +220,78 @@ pub fn analyse_log_with(
         })
         .collect();
 
-    // Spectral lines (rate data only): found on each channel's longest segment, notched
-    // out of every segment before the noise fit.
-    let found: Vec<Vec<SpectralLine>> = if remove_lines && cfg.data_type == DataType::Frequency {
-        inputs
-            .par_iter()
-            .map(|(_, segs)| {
-                let longest = segs.iter().max_by_key(|s| s.len()).copied().unwrap_or(&[]);
-                lines::detect_lines(longest, log.tau0_s, &LineConfig::default())
-            })
-            .collect()
-    } else {
-        vec![Vec::new(); inputs.len()]
-    };
-    let cleaned: Vec<Option<Vec<Vec<f64>>>> = found
-        .par_iter()
-        .zip(&inputs)
-        .map(|(l, (_, segs))| {
-            (!l.is_empty()).then(|| {
-                segs.iter()
-                    .map(|s| lines::remove_lines(s, log.tau0_s, l))
-                    .collect()
-            })
-        })
-        .collect();
-    let fit_inputs: Vec<(&str, Vec<&[f64]>)> = inputs
-        .iter()
-        .zip(&cleaned)
-        .map(|((name, segs), c)| match c {
-            Some(c) => (*name, c.iter().map(Vec::as_slice).collect()),
-            None => (*name, segs.clone()),
-        })
-        .collect();
-    let any_lines = cleaned.iter().any(Option::is_some);
-    let oadev_cfg = AnalysisConfig {
-        estimator: Estimator::Oadev,
-        taus: TauSpec::Log(100),
-        fast: false,
-        ..cfg.clone()
-    };
-    // The line-free OADEV curves, and the same τ on the data as they are, for the σ shift.
-    let clean_curves = if any_lines && method.is_some() {
-        Some(analyse_channels(&fit_inputs, log.tau0_s, &oadev_cfg)?)
-    } else {
-        None
-    };
-    let mut lines_out = Vec::new();
-    if let Some(cc) = &clean_curves {
-        let raw_curves = if cfg.estimator == Estimator::Oadev && cfg.taus == TauSpec::Log(100) {
-            None
+    // Spectral lines (rate data, when a noise model is fitted): found on each channel's
+    // longest segment, notched out of every segment before the fit.
+    let found: Vec<Vec<SpectralLine>> =
+        if remove_lines && method.is_some() && cfg.data_type == DataType::Frequency {
+            inputs
+                .par_iter()
+                .map(|(_, segs)| {
+                    let longest = segs.iter().max_by_key(|s| s.len()).copied().unwrap_or(&[]);
+                    lines::detect_lines(longest, log.tau0_s, &LineConfig::default())
+                })
+                .collect()
         } else {
-            Some(analyse_channels(&inputs, log.tau0_s, &oadev_cfg)?)
+            vec![Vec::new(); inputs.len()]
         };
-        let raw = raw_curves.as_deref().unwrap_or(&results);
-        for (k, l) in found.iter().enumerate() {
-            if l.is_empty() {
-                continue;
-            }
-            let tau: Vec<f64> = cc[k].points.iter().map(|p| p.tau).collect();
-            let with: Vec<f64> = raw[k].points.iter().map(|p| p.dev).collect();
-            let without: Vec<f64> = cc[k].points.iter().map(|p| p.dev).collect();
-            let (inc, at) = lines::sigma_increase(&tau, &with, &without);
-            lines_out.push(ChannelLines {
-                channel: inputs[k].0.to_string(),
-                lines: l.clone(),
-                max_sigma_increase: inc,
-                at_tau_s: at,
-            });
+    let with_lines: Vec<usize> = (0..found.len()).filter(|&k| !found[k].is_empty()).collect();
+    let cleaned: Vec<Vec<Vec<f64>>> = with_lines
+        .par_iter()
+        .map(|&k| {
+            inputs[k]
+                .1
+                .iter()
+                .map(|s| lines::remove_lines(s, log.tau0_s, &found[k]))
+                .collect()
+        })
+        .collect();
+    let mut fit_inputs: Vec<(&str, Vec<&[f64]>)> = inputs.clone();
+    for (&k, c) in with_lines.iter().zip(&cleaned) {
+        fit_inputs[k].1 = c.iter().map(Vec::as_slice).collect();
+    }
+    // The Allan fit's curve: the requested one when it is OADEV, else OADEV on a log grid;
+    // recomputed on the line-free data only for the channels that had lines.
+    let fit_cfg = if cfg.estimator == Estimator::Oadev {
+        cfg.clone()
+    } else {
+        AnalysisConfig {
+            estimator: Estimator::Oadev,
+            taus: TauSpec::Log(100),
+            fast: false,
+            ..cfg.clone()
         }
+    };
+    let needs_curves = matches!(method, Some(NoiseMethod::Allan(_))) || !with_lines.is_empty();
+    let base_curves;
+    let base: &[ChannelResult] = if cfg.estimator == Estimator::Oadev {
+        &results
+    } else if needs_curves {
+        base_curves = analyse_channels(&inputs, log.tau0_s, &fit_cfg)?;
+        &base_curves
+    } else {
+        &[]
+    };
+    let line_inputs: Vec<(&str, Vec<&[f64]>)> =
+        with_lines.iter().map(|&k| fit_inputs[k].clone()).collect();
+    let clean_curves = if line_inputs.is_empty() {
+        Vec::new()
+    } else {
+        analyse_channels(&line_inputs, log.tau0_s, &fit_cfg)?
+    };
+    let mut fit_curves: Vec<ChannelResult> = base.to_vec();
+    let mut lines_out = Vec::new();
+    for (&k, cc) in with_lines.iter().zip(clean_curves) {
+        let tau: Vec<f64> = cc.points.iter().map(|p| p.tau).collect();
+        let with: Vec<f64> = base[k].points.iter().map(|p| p.dev).collect();
+        let without: Vec<f64> = cc.points.iter().map(|p| p.dev).collect();
+        let (inc, at) = lines::sigma_increase(&tau, &with, &without);
+        lines_out.push(ChannelLines {
+            channel: inputs[k].0.to_string(),
+            lines: found[k].clone(),
+            max_sigma_increase: inc,
+            at_tau_s: at,
+        });
+        fit_curves[k] = cc;
     }
     let mut gmwm_channels = Vec::new();
     let noise = match method {
@@ -297,27 +301,13 @@ pub fn analyse_log_with(
                 .with_context(|| format!("GMWM of {}", log.source))?;
             Some(gmwm::noise_model(&log.source, &gmwm_channels, &quantities)?)
         }
-        Some(NoiseMethod::Allan(fc)) => {
-            // The noise model is an Allan-variance model: fit an OADEV curve (of the
-            // line-free data). Reuse the requested one when it is that curve, otherwise
-            // compute one on a log grid.
-            let oadev_results;
-            let curves: &[ChannelResult] = if let Some(cc) = &clean_curves {
-                cc
-            } else if cfg.estimator == Estimator::Oadev {
-                &results
-            } else {
-                oadev_results = analyse_channels(&inputs, log.tau0_s, &oadev_cfg)?;
-                &oadev_results
-            };
-            Some(NoiseModel::from_curves(
-                &log.source,
-                curves,
-                &quantities,
-                fc,
-                cfg.confidence,
-            )?)
-        }
+        Some(NoiseMethod::Allan(fc)) => Some(NoiseModel::from_curves(
+            &log.source,
+            &fit_curves,
+            &quantities,
+            fc,
+            cfg.confidence,
+        )?),
     };
     let mut warnings = Vec::new();
     for (&i, d) in keep.iter().zip(&data) {

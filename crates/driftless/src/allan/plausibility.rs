@@ -44,14 +44,15 @@ pub struct ChannelInput<'a> {
     pub values: &'a [f64],
 }
 
+/// Mean and sample standard deviation of the finite values (two passes, no copy).
 fn mean_sd(v: &[f64]) -> Option<(f64, f64)> {
-    let finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
-    if finite.len() < 2 {
+    let finite = || v.iter().copied().filter(|x| x.is_finite());
+    let (n, sum) = finite().fold((0usize, 0.0), |(n, s), x| (n + 1, s + x));
+    if n < 2 {
         return None;
     }
-    let n = finite.len() as f64;
-    let m = finite.iter().sum::<f64>() / n;
-    let var = finite.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+    let m = sum / n as f64;
+    let var = finite().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1) as f64;
     Some((m, var.sqrt()))
 }
 
