@@ -255,6 +255,12 @@ pub fn run(a: NavArgs) -> Result<()> {
             "gnss_rejected": run.gnss_rejected,
             "gnss_withheld": run.gnss_withheld,
             "gnss_forced": run.gnss_forced,
+            "gnss_sigma_floor": if sc.auto_sigma_floor { "auto" } else { "fixed" },
+            "gnss_sigma_floors": res.sigma_floors.iter().map(|f| serde_json::json!({
+                "quality": quality_name(f.quality), "kind": format!("{:?}", f.kind).to_lowercase(),
+                "fixes": f.fixes, "horizontal": f.horizontal, "vertical": f.vertical,
+                "file_sigma_horizontal": f.file_sigma.0, "file_sigma_vertical": f.file_sigma.1,
+            })).collect::<Vec<_>>(),
             "horizontal_rms_m": res.horizontal_rms_m.map(|r| r.0),
             "horizontal_rms_fixes": res.horizontal_rms_m.map(|r| r.1),
             "outages": res.outages.iter().map(|o| serde_json::json!({
@@ -285,6 +291,9 @@ pub fn run(a: NavArgs) -> Result<()> {
         "GNSS: {} accepted, {} rejected by the gate, {} withheld by outages, {} dropped by the quality filter",
         run.gnss_accepted, run.gnss_rejected, run.gnss_withheld, job.dropped_by_quality
     );
+    if sc.auto_sigma_floor {
+        println!("{}", floor_summary(&res.sigma_floors));
+    }
     if let Some((rms, n)) = res.horizontal_rms_m {
         println!(
             "full-GNSS horizontal one-step prediction error: RMS {rms:.3} m over {n} fixes \
@@ -336,6 +345,46 @@ pub fn run(a: NavArgs) -> Result<()> {
         println!("KF-GINS-format outputs written to {}", dir.display());
     }
     Ok(())
+}
+
+/// RTKLIB quality name of a flag.
+fn quality_name(q: u8) -> &'static str {
+    driftless::nav::config::QUALITY_NAMES
+        .get(q as usize)
+        .copied()
+        .unwrap_or("unknown")
+}
+
+/// One line per class of the estimated GNSS σ floor (`--gnss-sigma-floor auto`).
+fn floor_summary(floors: &[driftless::nav::gnss_floor::ClassFloor]) -> String {
+    use driftless::nav::filter::UpdateKind;
+    if floors.is_empty() {
+        return format!(
+            "GNSS σ floor: not estimated (fewer than {} usable fixes per solution quality after              the convergence period): the file's σ is used; give --gnss-sigma-floor M if the              antenna moves",
+            driftless::nav::gnss_floor::MIN_FIXES
+        );
+    }
+    let mut out = String::from(
+        "GNSS σ floor estimated from the innovations of a first pass (--gnss-sigma-floor auto):",
+    );
+    for f in floors {
+        let unit = if f.kind == UpdateKind::Position {
+            "m"
+        } else {
+            "m/s"
+        };
+        out.push_str(&format!(
+            "\n  {} {}: {:.3} {unit} horizontal, {:.3} {unit} vertical from {} fixes (file σ {:.3} / {:.3} {unit})",
+            quality_name(f.quality),
+            if f.kind == UpdateKind::Position { "position" } else { "velocity" },
+            f.horizontal,
+            f.vertical,
+            f.fixes,
+            f.file_sigma.0,
+            f.file_sigma.1,
+        ));
+    }
+    out
 }
 
 /// The automatically chosen windows and the dynamics inside them.

@@ -89,12 +89,32 @@ fn drive_0708_full_rtk_and_outages() {
     let plain = SessionConfig::new(FilterConfig::new(consumer_mems_noise(), LEVER_ARM_B_M));
     let p = run_session(&imu, &all.fixes, &plain).unwrap();
     eprintln!(
-        "defaults (no aids, file σ, robust gate): full-RTK one-step RMS {:.3} m, {} rejected, \
+        "defaults (no aids, estimated σ floor, robust gate): full-RTK one-step RMS {:.3} m, {} rejected, \
          {} inflated, {} forced",
         p.horizontal_rms_m.map_or(f64::NAN, |x| x.0),
         p.run.gnss_rejected,
         p.run.gnss_inflated,
         p.run.gnss_forced
+    );
+    let floor = &p.sigma_floors;
+    eprintln!(
+        "  σ floor estimated from the first pass: {:?}",
+        floor
+            .iter()
+            .map(|f| (f.quality, f.fixes, f.horizontal, f.vertical))
+            .collect::<Vec<_>>()
+    );
+    // The estimate on a rigid roof antenna stays at a few centimetres.
+    assert!(
+        floor.len() == 1 && floor[0].horizontal < 0.06 && floor[0].vertical < 0.06,
+        "{floor:?}"
+    );
+    let mut file_sigma = plain.clone();
+    file_sigma.auto_sigma_floor = false;
+    let f = run_session(&imu, &all.fixes, &file_sigma).unwrap();
+    eprintln!(
+        "defaults with the file's σ: full-RTK one-step RMS {:.3} m",
+        f.horizontal_rms_m.map_or(f64::NAN, |x| x.0)
     );
     let mut chi2 = plain.clone();
     chi2.filter.gate = Gate::Chi2 { p: 0.9999 };
@@ -218,6 +238,14 @@ fn drive_0708_from_published_values() {
         r.gnss_rejected,
         100.0 * r.gnss_rejected as f64 / total as f64,
         r.gnss_forced
+    );
+    eprintln!(
+        "  σ floor estimated from the first pass: {:?}",
+        full.session
+            .sigma_floors
+            .iter()
+            .map(|f| (f.quality, f.fixes, f.horizontal, f.vertical))
+            .collect::<Vec<_>>()
     );
     let out = run("6x60s every 80s from 80s");
     let ends: Vec<f64> = out

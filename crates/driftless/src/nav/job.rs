@@ -201,6 +201,7 @@ pub fn session_config(
     s.converge_s = c.outages.converge_s;
     s.reconverge_s = c.outages.reconverge_s;
     s.sigma_floor_m = c.sigma_floor_m();
+    s.auto_sigma_floor = c.auto_sigma_floor();
     s.smooth = c.filter.smooth;
     s.initial_sensor_sigma = Some(initial_sensor_sigma);
     Ok(s)

@@ -7,6 +7,7 @@ pub mod attitude;
 pub mod config;
 pub mod earth;
 pub mod filter;
+pub mod gnss_floor;
 pub mod job;
 pub mod kfgins_job;
 pub mod mechanization;

@@ -34,6 +34,13 @@
 //!   baseline (turning and antenna sway; conservative in a steady turn), floored at 1°.
 //!   Example: a 1.2 m/s walk with 4-Hz fixes of 5 cm σ, 2-s baseline, straight:
 //!   σ_vH = 0.035 m/s, σ_ψ ≈ 1.7°; with 10-cm σ 3.4°.
+//! * **GNSS σ floor** ([`SessionConfig::auto_sigma_floor`], on by default): a first
+//!   forward pass with the file's σ (after any fixed floor), without the outage windows,
+//!   gives the innovations from which [`super::gnss_floor`] estimates per solution quality
+//!   the σ the fixes really carry; the final pass uses the file's σ floored at that,
+//!   starting at the same fix as the first pass (its initial σ recomputed from the
+//!   floored fixes). The estimate describes the recording's GNSS, as a noise model
+//!   describes its IMU: withheld fixes count in it, one number per class and axis group.
 //! * **Evaluation**: the reference is the GNSS fixes themselves (on `drive_0708` an RTK
 //!   solution, cm level). The full-GNSS accuracy is the one-step prediction error at each
 //!   accepted fix — the horizontal innovation, i.e. the filter's antenna position *before*
@@ -89,6 +96,11 @@ pub struct SessionConfig {
     /// ~1 cm for a fixed RTK solution) ignore antenna vibration and IMU–GNSS time-tag
     /// error of a moving vehicle. `None` (default) keeps the file's σ.
     pub sigma_floor_m: Option<(f64, f64)>,
+    /// Floor the fixes' σ (after `sigma_floor_m`) at what the innovations of a first pass
+    /// call for, per solution quality ([`super::gnss_floor`]; module docs). Default true:
+    /// it finds decimetres on a swaying hand-held antenna and stays at or below the file's
+    /// σ where that is right. Costs a second forward pass.
+    pub auto_sigma_floor: bool,
     /// Also run the RTS smoother and report its errors inside the outages.
     pub smooth: bool,
     /// Initial σ of the 12 sensor states (b_g, b_a, s_g, s_a; e.g. the turn-on bias σ of
@@ -113,6 +125,7 @@ impl SessionConfig {
             converge_s: 60.0,
             reconverge_s: 30.0,
             sigma_floor_m: None,
+            auto_sigma_floor: true,
             smooth: false,
             initial_sensor_sigma: None,
         }
@@ -146,6 +159,9 @@ pub struct OutageResult {
 pub struct SessionResult {
     /// The forward run.
     pub run: ForwardRun,
+    /// The GNSS σ floors estimated from a first pass (empty unless
+    /// [`SessionConfig::auto_sigma_floor`]).
+    pub sigma_floors: Vec<super::gnss_floor::ClassFloor>,
     /// The initial state used.
     pub init: InitialState,
     /// Gyro bias primed from the static start, if it was static.
@@ -187,23 +203,66 @@ pub fn run_session(
         }
         None => gnss,
     };
-    let init = initialise(imu, used, cfg, primed)?;
     let mut fcfg = cfg.filter.clone();
     fcfg.outages_s = cfg.outages.iter().map(|w| (w.start_s, w.end_s)).collect();
+    let data_gaps = gnss_data_gaps(&used.time_s);
+    let excluded_from = |t0: f64| {
+        let gaps = &data_gaps;
+        move |t: f64| {
+            t < t0 + cfg.converge_s
+                || cfg
+                    .outages
+                    .iter()
+                    .map(|w| (w.start_s, w.end_s))
+                    .chain(gaps.iter().copied())
+                    .any(|(a, b)| t > a && t <= b + cfg.reconverge_s)
+        }
+    };
+    let mut floors = Vec::new();
+    let mut start_s = None;
+    let auto;
+    let used = if cfg.auto_sigma_floor {
+        let mut full = cfg.clone();
+        full.outages.clear();
+        let init = initialise(imu, used, &full, primed)?;
+        start_s = Some(init.nav.time_s);
+        let mut ffull = fcfg.clone();
+        ffull.outages_s.clear();
+        let first = run_forward(&imu.epochs, used, init, &ffull)?;
+        let t0 = init.nav.time_s;
+        let excluded = |t: f64| {
+            t < t0 + cfg.converge_s
+                || data_gaps
+                    .iter()
+                    .any(|&(a, b)| t > a && t <= b + cfg.reconverge_s)
+        };
+        floors = super::gnss_floor::estimate(
+            first
+                .updates
+                .iter()
+                .flat_map(|u| u.outcomes.iter().copied()),
+            used,
+            &fcfg.quality_scale,
+            |t| !excluded(t),
+        );
+        auto = super::gnss_floor::apply(used, &floors, &fcfg.quality_scale);
+        &auto
+    } else {
+        used
+    };
+    let init = match start_s {
+        // The first pass ran without the outage windows: start there unless a window
+        // withholds that fix, then as usual.
+        Some(t) if !cfg.outages.iter().any(|w| w.contains(t)) => {
+            initialise_at(imu, used, cfg, primed, Some(t))
+                .or_else(|_| initialise(imu, used, cfg, primed))?
+        }
+        _ => initialise(imu, used, cfg, primed)?,
+    };
     let run = run_forward(&imu.epochs, used, init, &fcfg)?;
 
     // Full-GNSS accuracy: prior innovations at accepted position fixes.
-    let t0 = init.nav.time_s;
-    let data_gaps = gnss_data_gaps(&used.time_s);
-    let excluded = |t: f64| {
-        t < t0 + cfg.converge_s
-            || cfg
-                .outages
-                .iter()
-                .map(|w| (w.start_s, w.end_s))
-                .chain(data_gaps.iter().copied())
-                .any(|(a, b)| t > a && t <= b + cfg.reconverge_s)
-    };
+    let excluded = excluded_from(init.nav.time_s);
     let mut sum2 = 0.0;
     let mut count = 0usize;
     for u in &run.updates {
@@ -243,6 +302,7 @@ pub fn run_session(
     Ok(SessionResult {
         run,
         init,
+        sigma_floors: floors,
         primed_gyro_bias_rad_s: primed,
         horizontal_rms_m,
         outages,
@@ -344,6 +404,19 @@ pub fn initialise(
     cfg: &SessionConfig,
     primed_gyro_bias: Option<Vec3>,
 ) -> Result<InitialState, NavError> {
+    initialise_at(imu, gnss, cfg, primed_gyro_bias, None)
+}
+
+/// [`initialise`], or with `start_s` at the fix of that time whatever its speed and
+/// course σ (the second pass of an estimated σ floor starts where the first did, its σ
+/// recomputed from the floored fixes).
+fn initialise_at(
+    imu: &ImuStream,
+    gnss: &GnssFixes,
+    cfg: &SessionConfig,
+    primed_gyro_bias: Option<Vec3>,
+    start_s: Option<f64>,
+) -> Result<InitialState, NavError> {
     let fcfg = &cfg.filter;
     let n = gnss.time_s.len();
     let imu_start = imu
@@ -430,6 +503,9 @@ pub fn initialise(
     let mut fastest: Option<(f64, f64)> = None;
     let start = (0..n).filter(|&i| usable(i)).find_map(|i| {
         let sv = velocity(i)?;
+        if let Some(t) = start_s {
+            return ((gnss.time_s[i] - t).abs() < 1e-6).then_some((i, sv));
+        }
         if given_yaw.is_some() {
             return Some((i, sv));
         }

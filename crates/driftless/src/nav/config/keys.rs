@@ -7,6 +7,8 @@
 pub enum ValueKind {
     /// A number (`-0.125`).
     Float,
+    /// A number or the word `auto`.
+    FloatOrAuto,
     /// `true` / `false`; the flag alone means `true`.
     Bool,
     /// Text (a name, a path, a value with its unit).
@@ -54,7 +56,7 @@ const fn key(
     }
 }
 
-use ValueKind::{Bool, Float, List, Table, Text, Vec3};
+use ValueKind::{Bool, Float, FloatOrAuto, List, Table, Text, Vec3};
 
 /// Every key, section by section.
 pub const KEYS: &[Key] = &[
@@ -167,9 +169,9 @@ pub const KEYS: &[Key] = &[
     key(
         "gnss.sigma_floor_m",
         "gnss-sigma-floor",
-        "M",
-        Float,
-        "floor on the fixes' horizontal σ, m (receivers' formal RTK σ of ~1 cm ignores antenna motion and time-tag error)",
+        "auto|M",
+        FloatOrAuto,
+        "floor on the fixes' σ: `auto` estimates it per solution quality from the innovations of a first pass (a receiver's formal RTK σ of ~1 cm ignores antenna motion, multipath and time-tag error; where the file's σ is right the estimate stays below it); a number is a fixed horizontal floor in m, 0 the file's σ",
         "",
     ),
     key(
@@ -177,7 +179,7 @@ pub const KEYS: &[Key] = &[
         "gnss-sigma-floor-vertical",
         "M",
         Float,
-        "floor on the vertical σ, m; default twice the horizontal floor",
+        "floor on the vertical σ, m; default: estimated with `auto`, else twice the horizontal floor",
         "0.1",
     ),
     key(

@@ -101,9 +101,10 @@ pub struct GnssSection {
     pub file: Option<PathBuf>,
     /// Antenna from the IMU, vehicle FRD, m.
     pub lever_arm_m: [f64; 3],
-    /// Horizontal σ floor, m.
-    pub sigma_floor_m: f64,
-    /// Vertical σ floor, m (default 2 × horizontal).
+    /// Horizontal σ floor: `auto` (estimated from the innovations of a first pass,
+    /// [`crate::nav::gnss_floor`]) or metres (0 = the file's σ).
+    pub sigma_floor_m: FloorSetting,
+    /// Vertical σ floor, m (default: estimated with `auto`, else 2 × horizontal).
     pub sigma_floor_vertical_m: Option<f64>,
     /// σ multiplier per quality name.
     pub sigma_scale: QualityTable,
@@ -118,12 +119,61 @@ impl Default for GnssSection {
         GnssSection {
             file: None,
             lever_arm_m: [0.0; 3],
-            sigma_floor_m: 0.0,
+            sigma_floor_m: FloorSetting::Auto,
             sigma_floor_vertical_m: None,
             sigma_scale: QualityTable::default(),
             accept: QUALITY_NAMES.iter().map(|s| (*s).to_owned()).collect(),
             use_velocity: true,
         }
+    }
+}
+
+/// `gnss.sigma_floor_m`: the word `auto` or a number of metres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FloorSetting {
+    /// Estimated from the data ([`crate::nav::gnss_floor`]).
+    Auto,
+    /// A fixed floor, m (0 = none).
+    Metres(f64),
+}
+
+impl Serialize for FloorSetting {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            FloorSetting::Auto => s.serialize_str("auto"),
+            FloorSetting::Metres(m) => s.serialize_f64(*m),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for FloorSetting {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = FloorSetting;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("\"auto\" or a number of metres")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<FloorSetting, E> {
+                if v.trim() == "auto" {
+                    Ok(FloorSetting::Auto)
+                } else {
+                    Err(E::custom(format!(
+                        "{v:?}: expected \"auto\" or a number of metres"
+                    )))
+                }
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<FloorSetting, E> {
+                Ok(FloorSetting::Metres(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<FloorSetting, E> {
+                Ok(FloorSetting::Metres(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<FloorSetting, E> {
+                Ok(FloorSetting::Metres(v as f64))
+            }
+        }
+        d.deserialize_any(V)
     }
 }
 
@@ -475,6 +525,10 @@ fn flag_value(k: &Key, text: &str) -> Result<toml::Value, String> {
     };
     Ok(match k.kind {
         ValueKind::Float => toml::Value::Float(num(text)?),
+        ValueKind::FloatOrAuto => match text.trim() {
+            "auto" => toml::Value::String("auto".into()),
+            t => toml::Value::Float(num(t).map_err(|e| format!("{e} (or `auto`)"))?),
+        },
         ValueKind::Bool => match text.trim() {
             "true" | "yes" | "on" | "1" => toml::Value::Boolean(true),
             "false" | "no" | "off" | "0" => toml::Value::Boolean(false),
@@ -742,7 +796,9 @@ impl NavConfig {
                 ),
             ));
         }
-        nonneg("gnss.sigma_floor_m", g.sigma_floor_m, 1000.0, "m")?;
+        if let FloorSetting::Metres(m) = g.sigma_floor_m {
+            nonneg("gnss.sigma_floor_m", m, 1000.0, "m")?;
+        }
         if let Some(v) = g.sigma_floor_vertical_m {
             nonneg("gnss.sigma_floor_vertical_m", v, 1000.0, "m")?;
         }
@@ -891,11 +947,19 @@ impl NavConfig {
         QualityScale(self.gnss.sigma_scale.as_array())
     }
 
-    /// (horizontal, vertical) σ floor, m; `None` when both are zero.
+    /// (horizontal, vertical) fixed σ floor, m; `None` when both are zero. With `auto`
+    /// the horizontal part is 0 and the vertical one is `sigma_floor_vertical_m` if given.
     pub fn sigma_floor_m(&self) -> Option<(f64, f64)> {
-        let h = self.gnss.sigma_floor_m;
-        let v = self.gnss.sigma_floor_vertical_m.unwrap_or(2.0 * h);
+        let (h, v) = match self.gnss.sigma_floor_m {
+            FloorSetting::Auto => (0.0, self.gnss.sigma_floor_vertical_m.unwrap_or(0.0)),
+            FloorSetting::Metres(h) => (h, self.gnss.sigma_floor_vertical_m.unwrap_or(2.0 * h)),
+        };
         (h > 0.0 || v > 0.0).then_some((h, v))
+    }
+
+    /// True when the σ floor is estimated from the data (`gnss.sigma_floor_m = "auto"`).
+    pub fn auto_sigma_floor(&self) -> bool {
+        self.gnss.sigma_floor_m == FloorSetting::Auto
     }
 
     /// The innovation gate ([`Gate`]: `off`, `chi2:P`, `robust` or

@@ -49,9 +49,37 @@ fn flags_override_the_file_and_errors_name_their_origin() {
     .unwrap();
     assert_eq!(c.config.imu.time_offset_s, -0.125);
     assert_eq!(c.config.imu.mounting_rpy_deg, [180.0, 0.0, 180.0]);
-    assert_eq!(c.config.gnss.sigma_floor_m, 0.1);
+    assert_eq!(c.config.gnss.sigma_floor_m, FloorSetting::Metres(0.1));
     assert_eq!(c.config.sigma_floor_m(), Some((0.1, 0.2)));
+    assert!(!c.config.auto_sigma_floor());
     assert!(c.config.aids.zupt);
+
+    // The σ floor: estimated by default, `auto` or a number in the file and as a flag,
+    // anything else named with its position.
+    assert!(NavConfig::default().auto_sigma_floor());
+    assert_eq!(NavConfig::default().sigma_floor_m(), None);
+    let p = write(&d, "auto.toml", "[gnss]\nsigma_floor_m = 0.3\n");
+    let c = NavConfig::load(Some(&p), &[flag("gnss.sigma_floor_m", "auto")]).unwrap();
+    assert!(c.config.auto_sigma_floor());
+    let p = write(
+        &d,
+        "auto2.toml",
+        "[gnss]\nsigma_floor_m = \"auto\"\nsigma_floor_vertical_m = 0.5\n",
+    );
+    let c = NavConfig::load(Some(&p), &[]).unwrap();
+    assert!(c.config.auto_sigma_floor());
+    assert_eq!(c.config.sigma_floor_m(), Some((0.0, 0.5)));
+    let c = NavConfig::load(None, &[flag("gnss.sigma_floor_m", "0")]).unwrap();
+    assert!(!c.config.auto_sigma_floor() && c.config.sigma_floor_m().is_none());
+    let p = write(&d, "autox.toml", "[gnss]\nsigma_floor_m = \"automatic\"\n");
+    let e = NavConfig::load(Some(&p), &[]).unwrap_err();
+    assert!(e.location.ends_with("autox.toml:2:17"), "{e}");
+    assert!(e.message.contains("\"auto\" or a number of metres"), "{e}");
+    let e = NavConfig::load(None, &[flag("gnss.sigma_floor_m", "big")]).unwrap_err();
+    assert!(
+        e.location.starts_with("flag --gnss-sigma-floor") && e.message.contains("or `auto`"),
+        "{e}"
+    );
 
     // A bad value in the file: FILE:LINE:COL and the key.
     let p = write(&d, "bad.toml", "[gnss]\n# comment\nsigma_floor_m = -1.0\n");

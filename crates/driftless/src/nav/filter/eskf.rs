@@ -82,6 +82,9 @@ pub struct UpdateOutcome {
     /// Factor λ ≥ 1 by which the robust gate ([`Gate::Robust`]) inflated R for this
     /// update (1 when not inflated or not applied).
     pub r_scale: f64,
+    /// Diagonal of H P⁻ Hᵀ, the predicted measurement's own variance before the update
+    /// (same units as the innovation, squared; 0 beyond the measurement's dimension).
+    pub hph_diag: Vec3,
 }
 
 /// The filter. See the module documentation.
@@ -554,6 +557,10 @@ impl Eskf {
         let r = r0.map(|v| v * lambda);
         let mut innovation = [0.0; 3];
         innovation[..M].copy_from_slice(&y);
+        let mut hph_diag = [0.0; 3];
+        for (m, v) in hph_diag.iter_mut().enumerate().take(M) {
+            *v = hph[m][m];
+        }
         let out = UpdateOutcome {
             kind,
             time_s: t,
@@ -561,6 +568,7 @@ impl Eskf {
             nis,
             accepted,
             r_scale: if accepted { lambda } else { 1.0 },
+            hph_diag,
         };
         if !accepted {
             return Ok(out);
