@@ -84,7 +84,7 @@ pub struct AllanArgs {
     #[arg(long)]
     pub json: bool,
     /// Write a log-log plot (SVG, or PNG when built with the `png` feature).
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE.svg|FILE.png", value_parser = crate::output::figure_path)]
     pub plot: Option<PathBuf>,
     /// Save the fitted noise model (TOML) for the filter and the simulator.
     #[arg(long, value_name = "FILE")]

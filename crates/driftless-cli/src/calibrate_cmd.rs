@@ -54,7 +54,7 @@ pub struct Common {
     #[arg(long, value_name = "FILE.toml")]
     pub out: Option<PathBuf>,
     /// Plot the accelerometer residuals per static interval (SVG, or PNG by extension).
-    #[arg(long, value_name = "FILE.svg")]
+    #[arg(long, value_name = "FILE.svg|FILE.png", value_parser = crate::output::figure_path)]
     pub plot: Option<PathBuf>,
     /// Machine-readable output.
     #[arg(long)]

@@ -16,7 +16,7 @@ pub struct InputArgs {
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub instance: u8,
     /// Sample rate in Hz (required when the file has no time column).
-    #[arg(long, value_name = "HZ")]
+    #[arg(long, value_name = "HZ", allow_hyphen_values = true)]
     pub rate: Option<f64>,
     /// Time column, by 1-based number or header name. Omitted: a header field named t,
     /// time, timestamp, time_s, stamp, sec, seconds, gps_time, gpst or time_stamp (any case,

@@ -1,4 +1,12 @@
-//! Human-readable tables.
+//! Human-readable tables, and checks of output names made before any work is done.
+
+/// `--plot FILE` value parser: the name must end in `.svg` or `.png` (PNG only in a build
+/// with the `png` feature), so a long analysis never ends in a refused or mislabelled file.
+pub fn figure_path(s: &str) -> Result<std::path::PathBuf, String> {
+    let p = std::path::PathBuf::from(s);
+    driftless::report::plot::check_figure_path(&p).map_err(|e| e.to_string())?;
+    Ok(p)
+}
 
 /// Format a number with 5 significant digits in scientific or plain notation.
 pub fn sci(v: f64) -> String {

@@ -161,7 +161,7 @@ pub struct SoakArgs {
     #[arg(long, value_name = "FILE.toml")]
     pub out: Option<PathBuf>,
     /// Plot bias and scale factor versus temperature with the fits (SVG, or PNG).
-    #[arg(long, value_name = "FILE.svg")]
+    #[arg(long, value_name = "FILE.svg|FILE.png", value_parser = crate::output::figure_path)]
     pub plot: Option<PathBuf>,
     /// Machine-readable output.
     #[arg(long)]

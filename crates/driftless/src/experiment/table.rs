@@ -150,10 +150,17 @@ pub fn fmt_m(v: f64) -> String {
     }
 }
 
-/// A Markdown table.
+/// A Markdown table. A `|` inside a cell (e.g. `mean |·|`) is escaped as `\|` so that
+/// every row keeps the header's number of cells.
 pub fn markdown(header: &[String], rows: &[Vec<String>]) -> String {
+    let cells = |r: &[String]| {
+        r.iter()
+            .map(|c| c.replace('|', "\\|"))
+            .collect::<Vec<_>>()
+            .join(" | ")
+    };
     let mut s = String::new();
-    s.push_str(&format!("| {} |\n", header.join(" | ")));
+    s.push_str(&format!("| {} |\n", cells(header)));
     s.push_str(&format!(
         "|{}|\n",
         header
@@ -164,7 +171,7 @@ pub fn markdown(header: &[String], rows: &[Vec<String>]) -> String {
             .join("|")
     ));
     for r in rows {
-        s.push_str(&format!("| {} |\n", r.join(" | ")));
+        s.push_str(&format!("| {} |\n", cells(r)));
     }
     s
 }
@@ -463,4 +470,37 @@ pub fn ratio_explanation(p: &Prepared, r: &ExperimentResult) -> Vec<String> {
         p.scenario.filter.bias_tau_s
     ));
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Cells of a Markdown row, split on unescaped `|`.
+    fn cells(line: &str) -> usize {
+        let inner = line.trim().trim_start_matches('|').trim_end_matches('|');
+        let mut n = 1;
+        let mut prev = ' ';
+        for c in inner.chars() {
+            if c == '|' && prev != '\\' {
+                n += 1;
+            }
+            prev = c;
+        }
+        n
+    }
+
+    #[test]
+    fn markdown_rows_keep_the_header_cell_count() {
+        let header: Vec<String> = ["outage", "start", "case a"].map(String::from).to_vec();
+        let rows = vec![
+            ["#1", "10", "3.2"].map(String::from).to_vec(),
+            ["mean |·|", "", "1.5"].map(String::from).to_vec(),
+        ];
+        let md = markdown(&header, &rows);
+        for line in md.lines() {
+            assert_eq!(cells(line), 3, "{line}");
+        }
+        assert!(md.contains("mean \\|·\\|"), "{md}");
+    }
 }

@@ -19,6 +19,12 @@ pub enum PlotError {
     /// The PNG encoder failed.
     #[error("PNG encoding failed: {0}")]
     Encode(String),
+    /// The output name ends in neither `.svg` nor `.png`.
+    #[error(
+        "{}: a figure is written as SVG or PNG; end the file name in .svg or .png",
+        path.display()
+    )]
+    UnsupportedFormat { path: PathBuf },
     #[error("cannot write {}: {source}", path.display())]
     Io {
         path: PathBuf,

@@ -73,17 +73,41 @@ pub const PNG_SUPPORTED: bool = cfg!(feature = "png");
 /// high-DPI screens and in print).
 pub const DEFAULT_PNG_SCALE: f64 = 2.0;
 
-/// Writes the figure as PNG when `path` ends in `.png` (any case), else as SVG.
+/// Writes the figure as PNG when `path` ends in `.png`, as SVG when it ends in `.svg`
+/// (any case).
+///
+/// # Errors
+/// [`PlotError::UnsupportedFormat`] for any other name (nothing is written: a `.jpg`
+/// holding SVG text would be a wrong file), else as [`render_png`] / [`write_svg`].
 pub fn write_figure(fig: &Figure, path: impl AsRef<Path>) -> Result<(), PlotError> {
     let path = path.as_ref();
-    let is_png = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    if is_png {
+    if check_figure_path(path)? {
         render_png(fig, path)
     } else {
         write_svg(fig, path)
+    }
+}
+
+/// Checks a figure's output name before any work is done: `Ok(true)` for `.png`,
+/// `Ok(false)` for `.svg` (any case).
+///
+/// # Errors
+/// [`PlotError::UnsupportedFormat`] for any other ending; [`PlotError::PngUnsupported`]
+/// for `.png` in a build without the `png` feature.
+pub fn check_figure_path(path: &Path) -> Result<bool, PlotError> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if ext.eq_ignore_ascii_case("png") {
+        if PNG_SUPPORTED {
+            Ok(true)
+        } else {
+            Err(PlotError::PngUnsupported)
+        }
+    } else if ext.eq_ignore_ascii_case("svg") {
+        Ok(false)
+    } else {
+        Err(PlotError::UnsupportedFormat {
+            path: path.to_path_buf(),
+        })
     }
 }
 
