@@ -472,7 +472,7 @@ fn whole_process_runs(runs: usize, config: &std::path::Path) -> Result<WholeProc
     })
 }
 
-/// Simulation speed (issue 4): an 18-h, 100 Hz six-axis static log through the full
+/// Simulation speed: an 18-h, 100 Hz six-axis static log through the full
 /// sensor model with every error term (ADIS16465-like preset), and a 1-h, 200 Hz land
 /// drive (TOML profile) with ideal increments, sensor errors and 1 Hz GNSS.
 fn sim_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {

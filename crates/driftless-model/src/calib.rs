@@ -8,9 +8,9 @@
 //! with `raw` in the sensor's output units (counts, or SI for an IMU that already
 //! scales), `b` the bias in those units and `M` (3 × 3) scaling to SI (m/s² or rad/s)
 //! while correcting scale-factor errors and axis misalignment / non-orthogonality.
-//! This is the convention of `driftless calibrate --json` (issue 5) and of imu_tk
+//! This is the convention of `driftless calibrate --json` and of imu_tk
 //! (Tedaldi et al., ICRA 2014: `T·K·(raw − b)`, whose product T·K is M). Thermal
-//! dependence is added on top by the thermal model (issue 6).
+//! dependence is added on top by the thermal model.
 
 use crate::linalg::{Mat3, Vec3, sub};
 

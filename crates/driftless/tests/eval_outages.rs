@@ -1,4 +1,4 @@
-//! The evaluation module (issue 7, deliverable 2): outage metrics against closed-form
+//! The evaluation module: outage metrics against closed-form
 //! truths, dynamics classification of a simulated drive with known segments, automatic
 //! outage selection, and every bad-input error.
 

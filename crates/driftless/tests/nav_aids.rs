@@ -1,4 +1,4 @@
-//! Land-vehicle aids of the GNSS/INS filter (issue 3, deliverable 3, last sentence):
+//! Land-vehicle aids of the GNSS/INS filter:
 //! non-holonomic constraint with IMU mounting rotation, standstill detection, ZUPT and
 //! ZARU. Simulated data: an exact composite land-vehicle drive
 //! (`sim::ideal_imu::LandVehicle`: stops, straight runs with smooth speed changes,

@@ -1,5 +1,5 @@
 //! Acceptance tests of the 21-state GNSS/INS error-state filter and the alignment
-//! (issue 3, deliverables 3 and 4). Simulated data: ideal increments of an analytic
+//! Simulated data: ideal increments of an analytic
 //! figure-of-eight drive (`sim::ideal_imu`) plus injected biases and white noise, GNSS
 //! at the antenna (lever arm) at 1 Hz with 2 cm σ. Run with `cargo test --release`; the
 //! measured figures are printed (eprintln).

@@ -1,4 +1,4 @@
-//! Closed-form acceptance of the strapdown mechanization (issue 3, first acceptance point):
+//! Closed-form acceptance of the strapdown mechanization:
 //! perfect increments from `sim::ideal_imu`, mechanization started from the true state,
 //! errors against the analytic truth. Run in release; the figures are printed for
 //! VALIDATION.md.

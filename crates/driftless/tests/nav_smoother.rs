@@ -1,4 +1,4 @@
-//! Acceptance tests of the Rauch–Tung–Striebel smoother (issue 3, deliverable 5) on the
+//! Acceptance tests of the Rauch–Tung–Striebel smoother on the
 //! simulation of `tests/nav_filter.rs` (analytic figure-of-eight drive, injected biases
 //! and white noise, 1 Hz GNSS with 2 cm σ at a lever arm). Run with
 //! `cargo test --release`; the measured figures are printed (eprintln).

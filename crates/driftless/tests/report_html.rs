@@ -1,4 +1,4 @@
-//! The experiment's HTML report (issue 7, deliverable 3): a report with every figure
+//! The experiment's HTML report: a report with every figure
 //! type — trajectory with three outages, grouped per-outage bars on a log axis with a
 //! missing value, error growth, an Allan figure from a simulated log and the thermal
 //! figure from a simulated soak — checked two ways:

@@ -1,4 +1,4 @@
-//! Outage study on simulated data (issue 4, Simulation — acceptance).
+//! Outage study on simulated data.
 //!
 //! **Setup.** Truth: the 57-min, 28-km Wuhan RTK trajectory of the KF-GINS demo data set
 //! (`shared/data/trajectories/kfgins_wuhan_gnss_rtk_1hz.txt`, i2Nav-WHU/KF-GINS, GPL-3.0)

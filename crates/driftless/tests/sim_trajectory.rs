@@ -1,4 +1,4 @@
-//! A real vehicle's motion as simulation truth (issue 4, Simulation 1a/1b/2): the
+//! A real vehicle's motion as simulation truth: the
 //! 57-min, 28-km Wuhan RTK trajectory of the KF-GINS demo data set
 //! (`shared/data/trajectories/kfgins_wuhan_gnss_rtk_1hz.txt`, i2Nav-WHU/KF-GINS, GPL-3.0)
 //! smoothed into `sim::recorded::RecordedTrajectory`, ideal 200-Hz increments, and our

@@ -1,6 +1,6 @@
 //! PX4 `TC_*` / ArduPilot `INS_TCAL*` export → re-import → each autopilot's documented
-//! correction formula, against the model's own bias b + Δb(T) (issue 6 acceptance
-//! "Exports": same correction to 1e-6 at 10 temperatures), clamping outside the range,
+//! correction formula, against the model's own bias b + Δb(T)
+//! (the same correction to 1e-6 at 10 temperatures), clamping outside the range,
 //! the worked example of `docs/autopilot-thermal.md`, and the import's error messages.
 
 use driftless::thermal::autopilot::{

@@ -1,4 +1,4 @@
-//! Issue 6 acceptance "Compensation": a simulated vehicle log whose temperature rises
+//! Compensation: a simulated vehicle log whose temperature rises
 //! 25 → 45 °C; residual bias after compensation ≤ 5 % of the uncompensated thermal bias.
 //!
 //! The whole pipeline, with every noise term of the `adi-like` preset:

@@ -1,4 +1,4 @@
-//! Thermal polynomial fit (issue 6, deliverable 3): exactness, coverage, order advice,
+//! Thermal polynomial fit: exactness, coverage, order advice,
 //! bad input.
 
 use driftless::sim::rng::Rng;

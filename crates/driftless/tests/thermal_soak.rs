@@ -1,4 +1,4 @@
-//! The soak method on simulated `adi-like` chamber data (issue 6 acceptance "Recovery"):
+//! The soak method on simulated `adi-like` chamber data (recovery of the truth):
 //! −25…70 °C in 5 °C steps, soak, six positions and ±ω rate-table segments per step.
 //! Bar: fitted bias and scale-factor curves within 2 % of each curve's swing (RMS over the
 //! range) of the truth, and the truth inside the reported 95 % band at ≥ 90 % of the

@@ -1,4 +1,4 @@
-//! IMU calibration (issue 5): static-interval detection, six-position and rate-table
+//! IMU calibration: static-interval detection, six-position and rate-table
 //! calibration (Titterton & Weston; IEEE Std 1293), multi-position calibration without
 //! fixtures (Tedaldi, Pretto & Menegatti, ICRA 2014), with parameter uncertainties. The
 //! estimated model is [`driftless_model::calib::TriadCalibration`]:

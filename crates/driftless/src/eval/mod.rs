@@ -1,5 +1,4 @@
-//! Evaluation of navigation solutions against a reference trajectory (issue 7,
-//! deliverable 2): which dynamics a drive contains, where to put the GNSS outages, and the
+//! Evaluation of navigation solutions against a reference trajectory: which dynamics a drive contains, where to put the GNSS outages, and the
 //! errors a solution makes inside them.
 //!
 //! The intended flow of an outage experiment (the paper's Table 1):

@@ -1,4 +1,4 @@
-//! The figures of the paper's experiment (issue 7): the vehicle trajectory with its GNSS
+//! The figures of the paper's experiment: the vehicle trajectory with its GNSS
 //! outages and each solution's drift inside them (the seed paper's Fig. 2), the
 //! per-outage errors of each processing case as grouped bars (its Table 1 as a chart),
 //! and the error growth inside the outages, one panel per case.

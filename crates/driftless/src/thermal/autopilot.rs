@@ -1,4 +1,4 @@
-//! Autopilot thermal-compensation parameters (issue 6, deliverable 6): export the **bias
+//! Autopilot thermal-compensation parameters: export the **bias
 //! part** of a thermal model to PX4 `TC_*` parameters (QGroundControl `.params` file) and to
 //! ArduPilot `INS_TCAL*` parameters (Mission Planner `.param` file), read such files back,
 //! and evaluate each autopilot's own correction formula on what was read.

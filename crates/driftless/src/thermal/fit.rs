@@ -1,5 +1,5 @@
 //! Least-squares thermal polynomial fit by Householder QR on a centred, scaled
-//! temperature (issue 6, deliverable 3; seed paper §3.3 eqs. 1–2).
+//! temperature (seed paper §3.3 eqs. 1–2).
 //!
 //! # Model
 //!

@@ -1,4 +1,4 @@
-//! Thermal models (issue 6): a sensor parameter (bias, scale factor …) as a polynomial in
+//! Thermal models: a sensor parameter (bias, scale factor …) as a polynomial in
 //! the temperature difference ΔT = T − T_ref, seed paper §3.3 eqs. 1–2
 //! (cubics about t₀ = 25 °C fitted by least squares to soak-test results over −25…70 °C).
 //!

@@ -1,4 +1,4 @@
-//! The thermal compensation model file (TOML, issue 6 deliverable 4): the room
+//! The thermal compensation model file (TOML): the room
 //! calibration at T_ref and, per triad and axis, the bias and scale-factor deltas as
 //! polynomial coefficients of ΔT = T − T_ref, with the valid temperature range and the
 //! out-of-range policy; converts to and from

@@ -1,4 +1,4 @@
-//! The ramp method (issue 6 deliverable 2): bias versus temperature from one continuous
+//! The ramp method: bias versus temperature from one continuous
 //! warm-up or cool-down of a static sensor — what the autopilots' thermal calibrations
 //! do (PX4 `TC_*`, ArduPilot `INS_TCAL*`), with their known pains addressed:
 //!

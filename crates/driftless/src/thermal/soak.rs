@@ -1,4 +1,4 @@
-//! The soak method (issue 6 deliverable 1; seed paper §3.3): at every set temperature of
+//! The soak method (seed paper §3.3): at every set temperature of
 //! a chamber recording, a six-position + rate-table calibration
 //! ([`crate::calib::six_position`]) gives each axis's bias b_k(T) and scale factor
 //! A_kk(T) with their standard errors; each series is then fitted by a polynomial in

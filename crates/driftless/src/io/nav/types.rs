@@ -1,6 +1,6 @@
 //! Typed, columnar in-memory navigation records. SI units throughout; every field name
 //! carries its unit. Angles in radians; navigation frame north-east-down (NED); body frame
-//! forward-right-down (the frames KF-GINS and issue 3 use).
+//! forward-right-down (the frames KF-GINS uses).
 
 /// RTKLIB solution quality flags (`Q` column of a `.pos` file).
 pub mod quality {
