@@ -6,7 +6,7 @@
 
 use driftless::report::experiment_plots::{
     FIGURE_WIDTH, case_color, error_growth_figure, error_growth_figure_scaled, fit_to_width,
-    outage_bars_figure, trajectory_figure,
+    grouped_bars_figure, outage_bars_figure, trajectory_figure,
 };
 use driftless::report::plot::{AxisScale, Color, Figure, PALETTE, Plot, render_svg};
 
@@ -273,4 +273,66 @@ fn fit_to_width_shrinks_wide_grids_only() {
     let f = fit_to_width(many, 960.0);
     assert!(f.panel_width >= 300.0 && f.panel_height >= 230.0);
     assert_eq!(fit_to_width(narrow.clone(), f64::NAN), narrow);
+}
+
+/// No two outages of a panel look alike: nine outages (the demo's) in nine distinct
+/// colours, and beyond the ten colours the same colour comes back dashed.
+#[test]
+fn outage_lines_are_distinct_within_a_panel() {
+    let curve = |k: usize| -> Vec<(f64, f64)> {
+        (0..=10)
+            .map(|i| (f64::from(i), (k + 1) as f64 * f64::from(i)))
+            .collect()
+    };
+    for n in [9usize, 14] {
+        let cases = vec![("(a) raw".to_owned(), (0..n).map(curve).collect())];
+        let fig = error_growth_figure(&cases, "m");
+        let lines = &fig.panels[0].lines;
+        assert_eq!(lines.len(), n);
+        let looks: Vec<_> = lines.iter().map(|l| (l.color, l.style)).collect();
+        for i in 0..n {
+            for j in 0..i {
+                assert_ne!(
+                    looks[i],
+                    looks[j],
+                    "outages #{} and #{} alike",
+                    j + 1,
+                    i + 1
+                );
+            }
+        }
+        if n == 9 {
+            let mut colours: Vec<_> = lines.iter().map(|l| l.color).collect();
+            colours.dedup();
+            colours.sort_by_key(|c| format!("{c:?}"));
+            colours.dedup();
+            assert_eq!(colours.len(), 9, "nine outages, nine colours");
+        }
+    }
+}
+
+/// Bars grouped by something other than outages carry their own title and axis label:
+/// the Monte Carlo figure is not titled "Error per GNSS outage".
+#[test]
+fn grouped_bars_name_their_groups() {
+    let cases = vec![("(a) raw".to_owned(), vec![3.0, 4.0, 5.0])];
+    let runs: Vec<String> = ["1", "2", "3"].map(String::from).to_vec();
+    let fig = grouped_bars_figure(
+        "Mean end-of-outage error per Monte Carlo run",
+        "Monte Carlo run",
+        &runs,
+        &cases,
+        "m",
+        true,
+    );
+    let svg = render_svg(&fig);
+    let t = texts(&svg);
+    assert!(
+        t.iter()
+            .any(|x| x.0 == "Mean end-of-outage error per Monte Carlo run")
+    );
+    assert!(t.iter().any(|x| x.0 == "Monte Carlo run"));
+    assert!(!t.iter().any(|x| x.0.contains("GNSS outage")));
+    let o = render_svg(&outage_bars_figure(&runs, &cases, "m", true));
+    assert!(texts(&o).iter().any(|x| x.0 == "Error per GNSS outage"));
 }

@@ -12,8 +12,8 @@ use super::table::{Column, ratio_explanation, reversal_explanation, table_rows};
 use crate::io::nav::NavSolution;
 use crate::nav::earth::{meridian_radius_m, prime_vertical_radius_m};
 use crate::report::experiment_plots::{
-    FIGURE_WIDTH, GrowthCurves, error_growth_figure, fit_to_width, outage_bars_figure,
-    trajectory_figure,
+    FIGURE_WIDTH, GrowthCurves, error_growth_figure, fit_to_width, grouped_bars_figure,
+    outage_bars_figure, trajectory_figure,
 };
 use crate::report::html::HtmlReport;
 use crate::report::plot::{Figure, PlotError};
@@ -182,7 +182,14 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
                 "Mean end-of-outage error of each Monte Carlo run per case, forward filter ({} runs)",
                 r.runs.len()
             ),
-            outage_bars_figure(&run_labels, &per_run, "mean horizontal error [m]", true),
+            grouped_bars_figure(
+                "Mean end-of-outage error per Monte Carlo run",
+                "Monte Carlo run",
+                &run_labels,
+                &per_run,
+                "mean horizontal error [m]",
+                true,
+            ),
         ));
     }
     out.into_iter()

@@ -10,7 +10,7 @@
 //! long as its name starts with the paper's `(a)`, `(b)`, … tag ([`case_color`]).
 
 use super::plot::{
-    Annotation, AxisScale, Bars, Color, Figure, LegendPosition, Line, PALETTE, Plot,
+    Annotation, AxisScale, Bars, Color, Figure, LegendPosition, Line, LineStyle, PALETTE, Plot,
 };
 
 /// Natural width (px) of the experiment figures.
@@ -25,15 +25,30 @@ const OUTAGE_HIGHLIGHT: Color = Color::rgb(0xff, 0xd2, 0x6e);
 
 /// Line colours of the outages `#1`, `#2`, … in the error-growth panels: none of them is
 /// one of the first three case colours, so an outage is not mistaken for a case.
-const OUTAGE_COLORS: [Color; 7] = [
+/// Outage line colours: black and Paul Tol's "muted" scheme (distinct for colour-blind
+/// readers), ten in all; beyond ten the colours repeat with a dashed, then a dotted line
+/// ([`outage_style`]), so no two outages of one panel look alike.
+const OUTAGE_COLORS: [Color; 10] = [
     Color::rgb(0x00, 0x00, 0x00), // black
-    Color::rgb(0xcc, 0x79, 0xa7), // reddish purple
-    Color::rgb(0x56, 0xb4, 0xe9), // sky blue
-    Color::rgb(0xe6, 0x9f, 0x00), // orange
+    Color::rgb(0xcc, 0x66, 0x77), // rose
+    Color::rgb(0x33, 0x22, 0x88), // indigo
+    Color::rgb(0xdd, 0xcc, 0x77), // sand
+    Color::rgb(0x11, 0x77, 0x33), // green
+    Color::rgb(0x88, 0xcc, 0xee), // cyan
     Color::rgb(0x88, 0x22, 0x55), // wine
     Color::rgb(0x44, 0xaa, 0x99), // teal
     Color::rgb(0x99, 0x99, 0x33), // olive
+    Color::rgb(0xaa, 0x44, 0x99), // purple
 ];
+
+/// Colour and dash of outage `k` (0-based): unique for the first 30 outages.
+pub fn outage_style(k: usize) -> (Color, LineStyle) {
+    const STYLES: [LineStyle; 3] = [LineStyle::Solid, LineStyle::Dashed, LineStyle::Dotted];
+    (
+        OUTAGE_COLORS[k % OUTAGE_COLORS.len()],
+        STYLES[(k / OUTAGE_COLORS.len()) % STYLES.len()],
+    )
+}
 
 /// Colour of a processing case in the trajectory and bar figures: a name starting with
 /// the paper's tag `(a)`, `(b)`, … gets the tag's colour of [`PALETTE`] (so `(b) room
@@ -217,13 +232,33 @@ pub fn outage_bars_figure(
     y_label: &str,
     log_y: bool,
 ) -> Figure {
+    grouped_bars_figure(
+        "Error per GNSS outage",
+        "GNSS outage",
+        outage_labels,
+        cases,
+        y_label,
+        log_y,
+    )
+}
+
+/// [`outage_bars_figure`] for any grouping (e.g. one group per Monte Carlo run), with
+/// its own title and x-axis label; groups without a label are numbered `#k`.
+pub fn grouped_bars_figure(
+    title: &str,
+    x_label: &str,
+    outage_labels: &[String],
+    cases: &[(String, Vec<f64>)],
+    y_label: &str,
+    log_y: bool,
+) -> Figure {
     let groups = cases
         .iter()
         .map(|(_, v)| v.len())
         .fold(outage_labels.len(), usize::max);
     let nc = cases.len().max(1);
     let slot = 0.8 / nc as f64;
-    let mut plot = Plot::linear("Error per GNSS outage", "GNSS outage", y_label);
+    let mut plot = Plot::linear(title, x_label, y_label);
     if log_y {
         plot.y_scale = AxisScale::Log;
     }
@@ -334,9 +369,11 @@ pub fn error_growth_figure_scaled(
             p.y_range = y_range;
             for (k, track) in outages.iter().enumerate() {
                 let (x, y): (Vec<f64>, Vec<f64>) = track.iter().copied().unzip();
+                let (color, style) = outage_style(k);
                 p.lines.push(
                     Line::new(format!("#{}", k + 1), x, y)
-                        .with_color(OUTAGE_COLORS[k % OUTAGE_COLORS.len()])
+                        .with_color(color)
+                        .with_style(style)
                         .with_width(1.6),
                 );
             }

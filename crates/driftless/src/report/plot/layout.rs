@@ -691,15 +691,7 @@ fn layout_panel(plot: &Plot, cell: Rect, items: &mut Vec<Prim>) {
             continue;
         }
         let t = fit_text(t, LABEL_SIZE, area.w - 8.0);
-        let (w, h) = (text_width(&t, LABEL_SIZE) + 6.0, LABEL_SIZE + 6.0);
-        let mut r = Rect::new(p.0 + 7.0, p.1 - 7.0 - h, w, h);
-        if r.right() > area.right() - 2.0 {
-            r.x = p.0 - 7.0 - w;
-        }
-        if r.y < area.y + 2.0 {
-            r.y = p.1 + 7.0;
-        }
-        let r = clamp_into(r, &area);
+        let r = place_annotation_label(&t, p, &area, &obstacles);
         push_label(items, &r, &t, color);
         obstacles.boxes.push(r);
     }
@@ -1001,6 +993,36 @@ fn push_label(items: &mut Vec<Prim>, r: &Rect, label: &str, color: Color) {
 /// 1/48 of the visible length on both sides, scored by clutter (other
 /// labels, the legend, lines, markers) and distance from the preferred x
 /// (or from the middle of the visible part).
+/// Box of an annotation's text next to its point `p`: of the positions around the point
+/// (above/below × right/left, then further out) the one that covers the least of the
+/// data, lines, legends and labels already placed ([`Obstacles::score`]), inside the
+/// plot area; ties go to the first (above right).
+fn place_annotation_label(text: &str, p: Pt, area: &Rect, obstacles: &Obstacles) -> Rect {
+    let (w, h) = (text_width(text, LABEL_SIZE) + 6.0, LABEL_SIZE + 6.0);
+    let inner = area.inflate(-2.0);
+    let mut best: Option<(f64, Rect)> = None;
+    for gap in [7.0, 16.0, 28.0] {
+        for (sx, sy) in [(1.0, -1.0), (-1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            let x = if sx > 0.0 { p.0 + gap } else { p.0 - gap - w };
+            let y = if sy < 0.0 { p.1 - gap - h } else { p.1 + gap };
+            let mut r = Rect::new(x, y, w, h);
+            let mut score = 0.1 * gap;
+            if !inner.contains_rect(&r) {
+                r = clamp_into(r, area);
+                score += 500.0;
+            }
+            score += obstacles.score(&r);
+            if best.is_none_or(|(b, _)| score < b) {
+                best = Some((score, r));
+            }
+        }
+    }
+    best.map_or_else(
+        || clamp_into(Rect::new(p.0 + 7.0, p.1 - 7.0 - h, w, h), area),
+        |b| b.1,
+    )
+}
+
 fn place_label(
     label: &str,
     runs: &[Vec<Pt>],
@@ -1048,7 +1070,9 @@ fn place_label(
             }
             score += obstacles.score(&r);
             score += match preferred_x {
-                Some(px) => 0.5 * (c.0 - px).abs(),
+                // The preferred place yields to any data it would cover (a marker costs
+                // 40, as much as moving 400 px).
+                Some(px) => 0.1 * (c.0 - px).abs(),
                 None => 0.1 * (s - total / 2.0).abs(),
             };
             if best.is_none_or(|(bs, _)| score < bs) {
