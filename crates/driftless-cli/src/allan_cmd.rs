@@ -367,6 +367,10 @@ pub fn analyse_log_with(
 }
 
 pub fn run(a: AllanArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(
+        &[a.save_model.as_deref(), a.plot.as_deref()],
+        &[Some(&a.file)],
+    )?;
     let cfg = analysis_config(&a)?;
     let fit = if a.no_fit {
         None

@@ -191,6 +191,10 @@ fn raw_unit(log: &ImuLog, q: Quantity) -> String {
 }
 
 fn multi(m: MultiArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(
+        &[m.common.out.as_deref(), m.common.plot.as_deref()],
+        &[Some(&m.accel), m.gyro.as_deref()],
+    )?;
     let g = gravity(&m.common)?;
     let acc_log = read(&m.common.input, &m.accel)?;
     let (accel, gyro, gyro_log) = match &m.gyro {
@@ -398,6 +402,10 @@ fn multi(m: MultiArgs) -> Result<()> {
 }
 
 fn six(s: SixArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(
+        &[s.common.out.as_deref(), s.common.plot.as_deref()],
+        &[Some(&s.log), s.manifest.as_deref()],
+    )?;
     let log = read(&s.common.input, &s.log)?;
     let (manifest, temp, source, segmentation) = match &s.manifest {
         Some(path) => {

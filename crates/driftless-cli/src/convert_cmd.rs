@@ -17,6 +17,7 @@ pub struct ConvertArgs {
 }
 
 pub fn run(a: ConvertArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(&[Some(&a.output)], &[Some(&a.input)])?;
     let log = crate::allan_cmd::read_with_progress(&a.read, &a.input, false)?;
     let ext = a
         .output

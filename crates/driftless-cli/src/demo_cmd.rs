@@ -185,7 +185,7 @@ fn noise_demo(a: DemoArgs) -> Result<()> {
     if let Some(m) = &out.noise {
         m.save(&model_path)?;
     }
-    std::fs::write(
+    driftless::io::output::write(
         a.out.join("allan.json"),
         serde_json::to_string_pretty(&json_output(&out))?,
     )?;

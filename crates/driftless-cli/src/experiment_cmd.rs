@@ -178,7 +178,7 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
         md.push_str(&markdown(&h, &rows));
         md.push('\n');
         let path = out.join(file);
-        std::fs::write(&path, csv(&h, &rows))
+        driftless::io::output::write(&path, csv(&h, &rows))
             .with_context(|| format!("writing {}", path.display()))?;
         written.push(path);
     }
@@ -193,7 +193,7 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
         md.push_str("\n\n");
     }
     let path = out.join("table1.md");
-    std::fs::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
+    driftless::io::output::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
     written.push(path);
     let figs = driftless::experiment::report::figures(p, r);
     let fig_dir = out.join("figures");
@@ -210,7 +210,7 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
         .with_context(|| format!("writing {}", path.display()))?;
     written.push(path);
     let path = out.join("experiment.json");
-    std::fs::write(
+    driftless::io::output::write(
         &path,
         serde_json::to_string_pretty(&ExperimentDocument::new(p, r))?,
     )

@@ -16,6 +16,7 @@ mod experiment_cmd;
 mod input;
 mod nav_cmd;
 mod output;
+mod paths;
 mod segment_view;
 mod simulate_cmd;
 mod thermal_cmd;

@@ -16,6 +16,7 @@ use clap::Args;
 use driftless::io::nav::{
     KfGinsConfigRaw, write_kfgins_gnss, write_kfgins_imu, write_kfgins_nav, write_rtklib_pos,
 };
+use driftless::io::output::AtomicFile;
 use driftless::sim::scenario::{Scenario, Simulation, euler_of};
 use driftless_model::units::{DEG_PER_H, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H};
 use std::io::BufWriter;
@@ -89,10 +90,14 @@ pub fn run(a: SimulateArgs) -> Result<()> {
 
 fn write_outputs(sim: &Simulation, sc: &Scenario, dir: &Path) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
-    let create = |name: &str| -> Result<(BufWriter<std::fs::File>, PathBuf)> {
+    let create = |name: &str| -> Result<(AtomicFile, PathBuf)> {
         let p = dir.join(name);
-        let f = std::fs::File::create(&p).with_context(|| format!("creating {}", p.display()))?;
-        Ok((BufWriter::with_capacity(1 << 20, f), p))
+        let f = AtomicFile::create(&p).with_context(|| format!("creating {}", p.display()))?;
+        Ok((f, p))
+    };
+    let commit = |f: AtomicFile, p: &Path| -> Result<()> {
+        f.commit()
+            .with_context(|| format!("writing {}", p.display()))
     };
     let source = format!("driftless simulate {}", sc.name);
     // The big files are independent: write them concurrently.
@@ -104,11 +109,13 @@ fn write_outputs(sim: &Simulation, sc: &Scenario, dir: &Path) -> Result<Vec<Path
         },
         || -> Result<Vec<PathBuf>> {
             let mut out = Vec::new();
-            let (w, p) = create("imu.txt")?;
-            write_kfgins_imu(w, &p.display().to_string(), &sim.increments())?;
+            let (mut f, p) = create("imu.txt")?;
+            write_kfgins_imu(buf(&mut f), &p.display().to_string(), &sim.increments())?;
+            commit(f, &p)?;
             out.push(p);
-            let (w, p) = create("truth.nav")?;
-            write_kfgins_nav(w, &p.display().to_string(), &sim.truth, 0)?;
+            let (mut f, p) = create("truth.nav")?;
+            write_kfgins_nav(buf(&mut f), &p.display().to_string(), &sim.truth, 0)?;
+            commit(f, &p)?;
             out.push(p);
             Ok(out)
         },
@@ -116,20 +123,22 @@ fn write_outputs(sim: &Simulation, sc: &Scenario, dir: &Path) -> Result<Vec<Path
     files.push(csv?);
     files.extend(kf?);
     if let Some(g) = &sim.gnss {
-        let (w, p) = create("gnss.txt")?;
-        write_kfgins_gnss(w, &p.display().to_string(), g)?;
+        let (mut f, p) = create("gnss.txt")?;
+        write_kfgins_gnss(buf(&mut f), &p.display().to_string(), g)?;
+        commit(f, &p)?;
         files.push(p);
-        let (w, p) = create("gnss.pos")?;
-        write_rtklib_pos(w, &p.display().to_string(), g, &source)?;
+        let (mut f, p) = create("gnss.pos")?;
+        write_rtklib_pos(buf(&mut f), &p.display().to_string(), g, &source)?;
+        commit(f, &p)?;
         files.push(p);
         let p = dir.join("kf-gins.yaml");
-        std::fs::write(&p, kfgins_config(sim).to_yaml())
+        driftless::io::output::write(&p, kfgins_config(sim).to_yaml())
             .with_context(|| format!("writing {}", p.display()))?;
         files.push(p);
     }
     if let Some(m) = &sim.manifest {
         let p = dir.join("manifest.toml");
-        std::fs::write(&p, m.to_toml_string()?)
+        driftless::io::output::write(&p, m.to_toml_string()?)
             .with_context(|| format!("writing {}", p.display()))?;
         files.push(p);
     }
@@ -142,9 +151,14 @@ fn write_outputs(sim: &Simulation, sc: &Scenario, dir: &Path) -> Result<Vec<Path
         sim.imu.accel_turn_on_bias_m_s2,
         toml::to_string(&sim.sensor).context("serialising the sensor configuration")?
     );
-    std::fs::write(&p, text).with_context(|| format!("writing {}", p.display()))?;
+    driftless::io::output::write(&p, text).with_context(|| format!("writing {}", p.display()))?;
     files.push(p);
     Ok(files)
+}
+
+/// A 1 MiB buffer in front of an output file.
+fn buf(f: &mut AtomicFile) -> BufWriter<&mut AtomicFile> {
+    BufWriter::with_capacity(1 << 20, f)
 }
 
 /// A KF-GINS configuration for the simulated files: the true initial state with small

@@ -396,6 +396,10 @@ fn soak_precheck(
 }
 
 fn soak(s: SoakArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(
+        &[s.out.as_deref(), s.plot.as_deref()],
+        &[Some(&s.log), s.manifest.as_deref(), s.noise_model.as_deref()],
+    )?;
     let policy = match s.out_of_range.as_str() {
         "clamp" => OutOfRange::Clamp,
         "extrapolate" => OutOfRange::Extrapolate,
@@ -596,6 +600,7 @@ fn soak_manifest(
 }
 
 fn ramp(r: RampArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(&[r.out.as_deref()], &[Some(&r.log)])?;
     use driftless::thermal::ramp::{RampOptions, ramp_calibration};
     let mut input = r.input.clone();
     input.time_column.get_or_insert_with(|| "1".into());
@@ -750,6 +755,10 @@ fn ramp(r: RampArgs) -> Result<()> {
 }
 
 fn export(e: ExportArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(
+        &[e.px4.as_deref(), e.ardupilot.as_deref()],
+        &[Some(&e.model)],
+    )?;
     use driftless::thermal::autopilot::{
         BiasModel, ExportOptions, check_temperatures, compare_ardupilot, compare_px4,
         export_ardupilot, export_px4, parse_ardupilot, parse_px4,
@@ -772,7 +781,7 @@ fn export(e: ExportArgs) -> Result<()> {
     let mut checks = Vec::new();
     if let Some(p) = &e.px4 {
         let text = export_px4(&bm, &opts)?;
-        std::fs::write(p, &text).with_context(|| format!("writing {}", p.display()))?;
+        driftless::io::output::write(p, &text).with_context(|| format!("writing {}", p.display()))?;
         let back = std::fs::read_to_string(p)?;
         let parsed = parse_px4(&back, &p.display().to_string(), e.instance)?;
         let err = compare_px4(&file, &model, &parsed, &temps, e.no_offsets)?;
@@ -780,7 +789,7 @@ fn export(e: ExportArgs) -> Result<()> {
     }
     if let Some(p) = &e.ardupilot {
         let text = export_ardupilot(&bm, &opts)?;
-        std::fs::write(p, &text).with_context(|| format!("writing {}", p.display()))?;
+        driftless::io::output::write(p, &text).with_context(|| format!("writing {}", p.display()))?;
         let back = std::fs::read_to_string(p)?;
         let mut parsed = parse_ardupilot(&back, &p.display().to_string(), e.instance)?;
         if e.no_offsets {

@@ -439,12 +439,23 @@ pub(crate) fn open_file(path: &std::path::Path) -> Result<(std::fs::File, u64, S
     Ok((file, size, name))
 }
 
-/// Creates (truncates) `path` for writing: (file, display name); errors name the file.
-pub(crate) fn create_file(path: &std::path::Path) -> Result<(std::fs::File, String), LogError> {
+/// Starts writing `path` atomically ([`crate::io::output::AtomicFile`]): (file, display
+/// name); errors name the file. [`commit_file`] puts it under its final name.
+pub(crate) fn create_file(
+    path: &std::path::Path,
+) -> Result<(crate::io::output::AtomicFile, String), LogError> {
     let name = path.display().to_string();
-    let file = std::fs::File::create(path).map_err(|error| LogError::Io {
+    let file = crate::io::output::AtomicFile::create(path).map_err(|error| LogError::Io {
         path: name.clone(),
         error,
     })?;
     Ok((file, name))
+}
+
+/// Flushes, syncs and renames a file from [`create_file`] over its final name.
+pub(crate) fn commit_file(file: crate::io::output::AtomicFile, name: &str) -> Result<(), LogError> {
+    file.commit().map_err(|error| LogError::Io {
+        path: name.to_owned(),
+        error,
+    })
 }

@@ -16,8 +16,9 @@ use super::log::ImuLog;
 
 /// Writes `log` as CSV to a file.
 pub fn write_csv_file(log: &ImuLog, path: impl AsRef<Path>) -> Result<(), LogError> {
-    let (file, name) = super::error::create_file(path.as_ref())?;
-    write_impl(log, file, &name)
+    let (mut file, name) = super::error::create_file(path.as_ref())?;
+    write_impl(log, &mut file, &name)?;
+    super::error::commit_file(file, &name)
 }
 
 /// Writes `log` as CSV to any writer (errors name the output `<output>`).
