@@ -535,7 +535,7 @@ fn print_results(a: &BenchArgs, results: &Results) -> Result<()> {
             .iter()
             .map(|(w, b, m, note)| serde_json::json!({"what": w, "best_s": b, "median_s": m, "note": note}))
             .collect();
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         let mut t = crate::output::Table::new(["benchmark", "best [s]", "median [s]", "note"]);
         for (w, b, m, note) in results {
@@ -546,8 +546,8 @@ fn print_results(a: &BenchArgs, results: &Results) -> Result<()> {
                 note.clone(),
             ]);
         }
-        print!("{}", t.render());
-        println!(
+        out!("{}", t.render());
+        outln!(
             "machine: {} cores (rayon threads: {})",
             std::thread::available_parallelism()
                 .map(|n| n.get())

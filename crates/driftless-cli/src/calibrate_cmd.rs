@@ -648,24 +648,24 @@ fn output(
         if let (Some(obj), serde_json::Value::Object(more)) = (v.as_object_mut(), extra) {
             obj.extend(more);
         }
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
     let mut tab = crate::output::Table::new(residuals.0);
     for row in residuals.1 {
         tab.row(row);
     }
-    println!("residuals of the calibrated accelerometer per static interval:");
-    print!("{}", tab.render());
-    println!();
+    outln!("residuals of the calibrated accelerometer per static interval:");
+    out!("{}", tab.render());
+    outln!();
     for (k, v) in summary {
-        println!("{k}: {v}");
+        outln!("{k}: {v}");
     }
     for (name, t, unit) in [
         ("accelerometer", &file.accel, "m/s²"),
         ("gyro", &file.gyro, "rad/s"),
     ] {
-        println!(
+        outln!(
             "\n{name}: calibrated [{unit}] = M · (raw − b); raw unit: {}",
             t.raw_unit
         );
@@ -692,10 +692,10 @@ fn output(
                 ),
             ]);
         }
-        print!("{}", tab.render());
+        out!("{}", tab.render());
     }
     for p in [&c.out, &c.plot].into_iter().flatten() {
-        println!("\nwrote {}", p.display());
+        outln!("\nwrote {}", p.display());
     }
     Ok(())
 }

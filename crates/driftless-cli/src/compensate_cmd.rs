@@ -182,7 +182,7 @@ pub fn run(a: CompensateArgs) -> Result<()> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
             (a.min(t), b.max(t))
         });
-    println!(
+    outln!(
         "{}: {n} samples at {lo:.2}–{hi:.2} °C compensated with model {:#x} (valid {:?} °C, {}{}) in {:.3} s → {}",
         a.log.display(),
         model.id(),

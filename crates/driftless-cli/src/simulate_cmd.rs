@@ -30,6 +30,11 @@ pub struct SimulateArgs {
     /// Output folder (default: the scenario's `[output] dir`, else `sim-out`).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Write into an output folder that already holds files: this run's files replace
+    /// theirs, and files an earlier simulation wrote that this run does not are removed.
+    /// Without it such a folder is refused, so that runs never mix.
+    #[arg(long)]
+    pub force: bool,
     /// Override the scenario's seed.
     #[arg(long)]
     pub seed: Option<u64>,
@@ -44,6 +49,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         sc.seed = s;
     }
     let dir = a.out.clone().unwrap_or_else(|| sc.output.dir.clone());
+    driftless::io::output::refuse_folder_in_use(&dir, a.force)?;
     let pb = crate::demo_cmd::spinner(!a.json, format!("simulating {}", a.scenario.display()));
     let t = Instant::now();
     let sim = sc.run()?;
@@ -52,11 +58,12 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     let t = Instant::now();
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let files = write_outputs(&sim, &sc, &dir)?;
+    remove_stale_outputs(&dir, &files)?;
     let write_s = t.elapsed().as_secs_f64();
     pb.finish_and_clear();
     let n_fix = sim.gnss.as_ref().map_or(0, |g| g.len());
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "imu_samples": sim.imu.len(),
@@ -70,7 +77,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
             }))?
         );
     } else {
-        println!(
+        outln!(
             "{}: {} IMU samples at {} Hz ({:.1} s), {} GNSS fixes, {} outage windows; seed {}",
             a.scenario.display(),
             sim.imu.len(),
@@ -80,9 +87,9 @@ pub fn run(a: SimulateArgs) -> Result<()> {
             sim.gnss_outages_s.len(),
             sc.seed
         );
-        println!("simulated in {sim_s:.2} s, written in {write_s:.2} s:");
+        outln!("simulated in {sim_s:.2} s, written in {write_s:.2} s:");
         for f in &files {
-            println!("  {}", f.display());
+            outln!("  {}", f.display());
         }
     }
     Ok(())
@@ -154,6 +161,31 @@ fn write_outputs(sim: &Simulation, sc: &Scenario, dir: &Path) -> Result<Vec<Path
     driftless::io::output::write(&p, text).with_context(|| format!("writing {}", p.display()))?;
     files.push(p);
     Ok(files)
+}
+
+/// Every file `simulate` may write.
+const OUTPUT_FILES: [&str; 8] = [
+    "imu.csv",
+    "imu.txt",
+    "truth.nav",
+    "gnss.txt",
+    "gnss.pos",
+    "kf-gins.yaml",
+    "manifest.toml",
+    "sensor.toml",
+];
+
+/// Removes the files of an earlier simulation in `dir` that this run (`written`) did not
+/// replace — a GNSS file of another trajectory must not sit beside this run's IMU file.
+fn remove_stale_outputs(dir: &Path, written: &[PathBuf]) -> Result<()> {
+    for name in OUTPUT_FILES {
+        let p = dir.join(name);
+        if written.iter().all(|w| w.file_name() != p.file_name()) && p.is_file() {
+            std::fs::remove_file(&p)
+                .with_context(|| format!("removing {} of an earlier run", p.display()))?;
+        }
+    }
+    Ok(())
 }
 
 /// A 1 MiB buffer in front of an output file.

@@ -261,7 +261,7 @@ fn check(c: CheckArgs) -> Result<()> {
         .map(|(label, log)| check_log(log, label, &opts))
         .collect();
     if c.json {
-        println!("{}", serde_json::to_string_pretty(&reports)?);
+        outln!("{}", serde_json::to_string_pretty(&reports)?);
         return Ok(());
     }
     let mut tab = crate::output::Table::new(
@@ -304,16 +304,16 @@ fn check(c: CheckArgs) -> Result<()> {
             r.verdict().to_string(),
         ]);
     }
-    print!("{}", tab.render());
+    out!("{}", tab.render());
     for r in &reports {
-        println!("{}: fit for {}", r.label, r.verdict());
+        outln!("{}: fit for {}", r.label, r.verdict());
         for f in &r.findings {
             let tag = |i: Impact| match i {
                 Impact::Block => "refused",
                 Impact::Warn => "warning",
                 Impact::None => "–",
             };
-            println!(
+            outln!(
                 "  [ramp {}, soak {}] {}",
                 tag(f.ramp),
                 tag(f.soak),
@@ -506,7 +506,7 @@ fn soak(s: SoakArgs) -> Result<()> {
                 })
             })
             .collect();
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "temperatures_c": soak.temperatures_c,
@@ -525,7 +525,7 @@ fn soak(s: SoakArgs) -> Result<()> {
         );
         return Ok(());
     }
-    println!(
+    outln!(
         "{} set temperatures {:?} °C; order {} about {} °C; {:.3} s",
         soak.temperatures_c.len(),
         soak.temperatures_c,
@@ -556,8 +556,8 @@ fn soak(s: SoakArgs) -> Result<()> {
         row.push(scatter_cell(&x.fit));
         tab.row(row);
     }
-    print!("{}", tab.render());
-    println!("{SCATTER_NOTE}");
+    out!("{}", tab.render());
+    outln!("{SCATTER_NOTE}");
     if let Some(g) = &g_mean {
         // Estimated per step (rate segments all +k up); the model file carries the mean.
         let d = |i: usize| {
@@ -567,7 +567,7 @@ fn soak(s: SoakArgs) -> Result<()> {
                 crate::output::sci(g.sigma_raw_per_m_s2[i][i])
             )
         };
-        println!(
+        outln!(
             "gyro g-sensitivity (mean over {} steps, per m/s^2): G_xx {}, G_yy {}, G_zz {}",
             soak.gyro_g_sensitivity.len(),
             d(0),
@@ -576,7 +576,7 @@ fn soak(s: SoakArgs) -> Result<()> {
         );
     }
     for p in [&s.out, &s.plot].into_iter().flatten() {
-        println!("wrote {}", p.display());
+        outln!("wrote {}", p.display());
     }
     Ok(())
 }
@@ -704,7 +704,7 @@ fn ramp(r: RampArgs) -> Result<()> {
                 })
             })
             .collect();
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "bins_heating": heating,
@@ -717,7 +717,7 @@ fn ramp(r: RampArgs) -> Result<()> {
         );
         return Ok(());
     }
-    println!(
+    outln!(
         "{} temperature bins ({heating} heating, {} cooling); order {} about {} °C",
         res.points.len(),
         res.points.len() - heating,
@@ -746,10 +746,10 @@ fn ramp(r: RampArgs) -> Result<()> {
         row.push(scatter_cell(f));
         tab.row(row);
     }
-    print!("{}", tab.render());
-    println!("{SCATTER_NOTE}");
+    out!("{}", tab.render());
+    outln!("{SCATTER_NOTE}");
     if let Some(p) = &r.out {
-        println!("wrote {} (bias-only model)", p.display());
+        outln!("wrote {} (bias-only model)", p.display());
     }
     Ok(())
 }
@@ -818,7 +818,7 @@ fn export(e: ExportArgs) -> Result<()> {
                 })
             })
             .collect();
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "model_id": file.model_id,
@@ -833,7 +833,7 @@ fn export(e: ExportArgs) -> Result<()> {
         );
     } else {
         for (ap, p, c) in &checks {
-            println!(
+            outln!(
                 "wrote {} ({ap}); read back, max |model − {ap}| over 10 temperatures in \
                  [{}, {}] °C: accel {} m/s², gyro {} rad/s (float32 arithmetic)",
                 p.display(),
@@ -843,14 +843,14 @@ fn export(e: ExportArgs) -> Result<()> {
                 crate::output::sci(c.gyro_f32)
             );
         }
-        println!(
+        outln!(
             "bias only: thermal scale-factor change dropped (max |Δs| accel {}, gyro {}); \
              misalignment and room scale left to the autopilot's own calibration",
             crate::output::sci(ds(&bm.accel)),
             crate::output::sci(ds(&bm.gyro))
         );
         if file.gyro_g_sensitivity.is_some() {
-            println!(
+            outln!(
                 "the model's gyro g-sensitivity is not exported: neither autopilot has a \
                  parameter for it"
             );

@@ -1,0 +1,221 @@
+//! What happens around a run when things go wrong: outputs that are inputs, writes that
+//! fail half-way, a closed or full standard output, a process killed mid-write. Every
+//! earlier file must survive, and nothing partial may sit under a final name.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+mod common;
+use common::bin;
+
+fn scratch(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("driftless-faults-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn scenario() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios/city-drive.toml")
+}
+
+/// Simulates the city drive with `seed` into `out` (which may hold an earlier run).
+fn simulate(out: &Path, seed: u64) {
+    let o = bin()
+        .args(["simulate", "--json", "--force", "--seed", &seed.to_string(), "--out"])
+        .arg(out)
+        .arg(scenario())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// Names in `dir` that are not `keep`: temporary files left behind, for instance.
+fn others(dir: &Path, keep: &[&str]) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| !keep.contains(&n.as_str()))
+        .collect()
+}
+
+fn stderr_of(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn an_output_that_is_an_input_is_refused() {
+    let d = scratch("same");
+    let log = d.join("log.csv");
+    let text = "time,gx\n0,1\n0.01,2\n0.02,3\n0.03,4\n";
+    std::fs::write(&log, text).unwrap();
+    std::fs::create_dir_all(d.join("sub")).unwrap();
+    let link = d.join("link.csv");
+    std::os::unix::fs::symlink(&log, &link).unwrap();
+    for out in [log.clone(), d.join("sub/../././log.csv"), link] {
+        let o = bin().arg("convert").arg(&log).arg(&out).output().unwrap();
+        assert_eq!(o.status.code(), Some(1), "{}", out.display());
+        assert!(stderr_of(&o).contains("is the input"), "{}", stderr_of(&o));
+        assert_eq!(std::fs::read_to_string(&log).unwrap(), text);
+    }
+    let o = bin()
+        .arg("compensate")
+        .arg(&log)
+        .args(["--model", "model.toml", "--out"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr_of(&o).contains("is the input"), "{}", stderr_of(&o));
+    assert_eq!(std::fs::read_to_string(&log).unwrap(), text);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A write that fails half-way (the file-size limit standing in for a full disk) leaves
+/// the earlier file as it was and no temporary file.
+#[test]
+fn a_failed_write_keeps_the_earlier_file() {
+    let d = scratch("efbig");
+    simulate(&d.join("sim"), 1);
+    let input = d.join("sim/imu.csv");
+    let out = d.join("out.csv");
+    std::fs::write(&out, "the earlier, good file\n").unwrap();
+    // SIGXFSZ ignored: a write past the limit fails with EFBIG, as on a full disk.
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg("trap '' XFSZ; ulimit -f 64; exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_driftless"))
+        .arg("convert")
+        .arg(&input)
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr_of(&o));
+    assert!(stderr_of(&o).contains("out.csv"), "{}", stderr_of(&o));
+    assert_eq!(
+        std::fs::read_to_string(&out).unwrap(),
+        "the earlier, good file\n"
+    );
+    assert!(others(&d, &["sim", "out.csv"]).is_empty(), "{:?}", others(&d, &["sim", "out.csv"]));
+    // A device that is full: a clear error, exit 1.
+    let o = bin().arg("convert").arg(&input).arg("/dev/full").output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr_of(&o).contains("/dev/full"), "{}", stderr_of(&o));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_closed_standard_output_ends_quietly() {
+    // The reader end is closed long before the command starts writing.
+    let mut child = Command::new("sh")
+        .arg("-c")
+        .arg("sleep 0.3; exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_driftless"))
+        .args(["nav", "--print-config"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr_of(&o));
+    assert!(o.stderr.is_empty(), "{}", stderr_of(&o));
+}
+
+#[test]
+fn a_full_standard_output_is_an_error() {
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let o = bin()
+        .args(["nav", "--print-config"])
+        .stdout(full)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr_of(&o));
+    let e = stderr_of(&o);
+    assert!(e.contains("standard output") && !e.contains("panicked"), "{e}");
+}
+
+#[test]
+fn a_folder_with_another_run_needs_force() {
+    let d = scratch("folder");
+    let out = d.join("sim");
+    simulate(&out, 1);
+    let before = std::fs::read(out.join("imu.txt")).unwrap();
+    let o = bin()
+        .args(["simulate", "--seed", "2", "--out"])
+        .arg(&out)
+        .arg(scenario())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr_of(&o).contains("--force"), "{}", stderr_of(&o));
+    assert_eq!(std::fs::read(out.join("imu.txt")).unwrap(), before);
+    // `nav --out` the same.
+    let o = bin()
+        .args(["nav", "--preset", "drive_0708", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr_of(&o).contains("already holds files"), "{}", stderr_of(&o));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `kill -9` at random instants of `simulate --force` over an earlier run: every file is
+/// the earlier run's or the complete new one, never a partial one.
+#[test]
+fn a_kill_mid_write_leaves_old_or_complete_files() {
+    let d = scratch("kill");
+    let (old, new) = (d.join("old"), d.join("new"));
+    simulate(&old, 1);
+    simulate(&new, 2);
+    let names = [
+        "imu.csv",
+        "imu.txt",
+        "truth.nav",
+        "gnss.txt",
+        "gnss.pos",
+        "kf-gins.yaml",
+        "sensor.toml",
+    ];
+    let read = |dir: &Path| names.map(|n| std::fs::read(dir.join(n)).unwrap());
+    let (old_bytes, new_bytes) = (read(&old), read(&new));
+    let mut state = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .subsec_nanos() as u64
+        | 1;
+    let mut saw_partial_run = false;
+    for trial in 0..12 {
+        let run = d.join(format!("run{trial}"));
+        simulate(&run, 1);
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let delay_ms = 20 + (state >> 33) % 250;
+        let mut child = bin()
+            .args(["simulate", "--json", "--force", "--seed", "2", "--out"])
+            .arg(&run)
+            .arg(scenario())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        let _ = child.kill();
+        let status = child.wait().unwrap();
+        for (k, n) in names.iter().enumerate() {
+            let got = std::fs::read(run.join(n)).unwrap();
+            assert!(
+                got == old_bytes[k] || got == new_bytes[k],
+                "trial {trial} ({delay_ms} ms, {status}): {n} is neither the old nor the new file ({} bytes)",
+                got.len()
+            );
+        }
+        let done: Vec<bool> = (0..names.len())
+            .map(|k| std::fs::read(run.join(names[k])).unwrap() == new_bytes[k])
+            .collect();
+        saw_partial_run |= done.iter().any(|&x| x) && !done.iter().all(|&x| x) || !status.success();
+    }
+    assert!(saw_partial_run, "no kill landed before the run ended");
+    let _ = std::fs::remove_dir_all(&d);
+}
