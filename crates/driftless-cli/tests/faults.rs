@@ -219,3 +219,28 @@ fn a_kill_mid_write_leaves_old_or_complete_files() {
     assert!(saw_partial_run, "no kill landed before the run ended");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A CSV written by driftless and cut at a line end (an interrupted `simulate` or
+/// `convert`) is an error naming the file and the rows expected and found, not a shorter
+/// log.
+#[test]
+fn a_cut_driftless_csv_is_an_error() {
+    let d = scratch("cut");
+    simulate(&d.join("sim"), 1);
+    let text = std::fs::read_to_string(d.join("sim/imu.csv")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let rows = lines.iter().filter(|l| !l.starts_with('#')).count() - 1;
+    let cut = d.join("cut.csv");
+    let keep = lines.len() * 4 / 5;
+    std::fs::write(&cut, lines[..keep].join("\n") + "\n").unwrap();
+    let o = bin().arg("allan").arg(&cut).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let e = stderr_of(&o);
+    assert!(
+        e.contains("cut.csv")
+            && e.contains(&format!("says {rows} rows, {} found", keep - 3))
+            && !e.contains("panicked"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -277,6 +277,23 @@ pub enum LogError {
         /// What was missing.
         message: String,
     },
+    /// Text log written by driftless: fewer or more data rows than its header states (the
+    /// file was cut at a line end, e.g. by an interrupted write).
+    #[error(
+        "{at}: truncated log: its header says {expected} rows, {found} found, {end_mark} (the \
+         file was cut, e.g. by an interrupted write; to read the rows present, delete the \
+         header's second comment line)"
+    )]
+    RowCountMismatch {
+        /// The input.
+        at: Location,
+        /// Rows the header states.
+        expected: usize,
+        /// Data rows read.
+        found: usize,
+        /// Whether the end mark the header announces is there.
+        end_mark: &'static str,
+    },
     /// Binary log: the data size disagrees with the header's row and column counts.
     #[error(
         "{at}: binary log size mismatch: header says {rows} rows × {columns} columns = {expected_bytes} bytes of data, found {found_bytes}"
@@ -378,6 +395,7 @@ impl LogError {
             | BadHeader { at, .. }
             | Truncated { at, .. }
             | CountMismatch { at, .. }
+            | RowCountMismatch { at, .. }
             | NonFiniteStored { at, .. }
             | Corrupt { at, .. }
             | InvalidLog { at, .. }
