@@ -93,10 +93,7 @@ pub fn warn_out_of_range(
 }
 
 pub fn run(a: CompensateArgs) -> Result<()> {
-    crate::paths::refuse_outputs_over_inputs(
-        &[Some(&a.out)],
-        &[Some(&a.log), Some(&a.model)],
-    )?;
+    crate::paths::refuse_outputs_over_inputs(&[Some(&a.out)], &[Some(&a.log), Some(&a.model)])?;
     let (file, model) = ThermalModelFile::load(&a.model)?;
     for (t, si) in [
         (&file.accel, ["m/s^2", "m/s²"]),

@@ -196,7 +196,10 @@ fn noise_demo(a: DemoArgs) -> Result<()> {
     }
     outln!(
         "driftless demo — simulated static six-axis IMU, {:.1} h at {} Hz ({} samples/axis), seed {}\n",
-        a.hours, a.rate, n, a.seed
+        a.hours,
+        a.rate,
+        n,
+        a.seed
     );
     out!("{}", truth_table(&truth, &out));
     outln!();

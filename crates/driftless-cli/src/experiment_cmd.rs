@@ -141,7 +141,8 @@ fn print_human(p: &Prepared, r: &ExperimentResult) {
         if let Some(m) = &c.first_failure {
             outln!(
                 "{}: failed in {} run(s), first: {m}",
-                c.label, c.failed_runs
+                c.label,
+                c.failed_runs
             );
         }
     }
@@ -193,7 +194,8 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
         md.push_str("\n\n");
     }
     let path = out.join("table1.md");
-    driftless::io::output::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
+    driftless::io::output::write(&path, md)
+        .with_context(|| format!("writing {}", path.display()))?;
     written.push(path);
     let figs = driftless::experiment::report::figures(p, r);
     let fig_dir = out.join("figures");

@@ -211,7 +211,11 @@ pub fn run(a: NavArgs) -> Result<()> {
     let gnss_file = (cfg.config.gnss.file.as_deref()).map(|p| cfg.path("gnss.file", p));
     crate::paths::refuse_outputs_over_inputs(
         &[a.csv.as_deref(), a.geojson.as_deref()],
-        &[a.config.as_deref(), imu_file.as_deref(), gnss_file.as_deref()],
+        &[
+            a.config.as_deref(),
+            imu_file.as_deref(),
+            gnss_file.as_deref(),
+        ],
     )?;
     // Navigation needs time stamps: the first column unless told otherwise.
     let mut input = a.input.clone();
@@ -297,13 +301,17 @@ pub fn run(a: NavArgs) -> Result<()> {
     );
     outln!(
         "GNSS: {} accepted, {} rejected by the gate, {} withheld by outages, {} dropped by the quality filter",
-        run.gnss_accepted, run.gnss_rejected, run.gnss_withheld, job.dropped_by_quality
+        run.gnss_accepted,
+        run.gnss_rejected,
+        run.gnss_withheld,
+        job.dropped_by_quality
     );
     if let Some((rms, n)) = res.horizontal_rms_m {
         outln!(
             "full-GNSS horizontal one-step prediction error: RMS {rms:.3} m over {n} fixes \
              (not counting {:.0} s after the start and {:.0} s after each outage)",
-            sc.converge_s, sc.reconverge_s
+            sc.converge_s,
+            sc.reconverge_s
         );
     }
     if let Some(sel) = &job.selection {

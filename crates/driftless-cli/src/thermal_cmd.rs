@@ -398,7 +398,11 @@ fn soak_precheck(
 fn soak(s: SoakArgs) -> Result<()> {
     crate::paths::refuse_outputs_over_inputs(
         &[s.out.as_deref(), s.plot.as_deref()],
-        &[Some(&s.log), s.manifest.as_deref(), s.noise_model.as_deref()],
+        &[
+            Some(&s.log),
+            s.manifest.as_deref(),
+            s.noise_model.as_deref(),
+        ],
     )?;
     let policy = match s.out_of_range.as_str() {
         "clamp" => OutOfRange::Clamp,
@@ -781,7 +785,8 @@ fn export(e: ExportArgs) -> Result<()> {
     let mut checks = Vec::new();
     if let Some(p) = &e.px4 {
         let text = export_px4(&bm, &opts)?;
-        driftless::io::output::write(p, &text).with_context(|| format!("writing {}", p.display()))?;
+        driftless::io::output::write(p, &text)
+            .with_context(|| format!("writing {}", p.display()))?;
         let back = std::fs::read_to_string(p)?;
         let parsed = parse_px4(&back, &p.display().to_string(), e.instance)?;
         let err = compare_px4(&file, &model, &parsed, &temps, e.no_offsets)?;
@@ -789,7 +794,8 @@ fn export(e: ExportArgs) -> Result<()> {
     }
     if let Some(p) = &e.ardupilot {
         let text = export_ardupilot(&bm, &opts)?;
-        driftless::io::output::write(p, &text).with_context(|| format!("writing {}", p.display()))?;
+        driftless::io::output::write(p, &text)
+            .with_context(|| format!("writing {}", p.display()))?;
         let back = std::fs::read_to_string(p)?;
         let mut parsed = parse_ardupilot(&back, &p.display().to_string(), e.instance)?;
         if e.no_offsets {

@@ -23,7 +23,14 @@ fn scenario() -> PathBuf {
 /// Simulates the city drive with `seed` into `out` (which may hold an earlier run).
 fn simulate(out: &Path, seed: u64) {
     let o = bin()
-        .args(["simulate", "--json", "--force", "--seed", &seed.to_string(), "--out"])
+        .args([
+            "simulate",
+            "--json",
+            "--force",
+            "--seed",
+            &seed.to_string(),
+            "--out",
+        ])
         .arg(out)
         .arg(scenario())
         .output()
@@ -97,9 +104,18 @@ fn a_failed_write_keeps_the_earlier_file() {
         std::fs::read_to_string(&out).unwrap(),
         "the earlier, good file\n"
     );
-    assert!(others(&d, &["sim", "out.csv"]).is_empty(), "{:?}", others(&d, &["sim", "out.csv"]));
+    assert!(
+        others(&d, &["sim", "out.csv"]).is_empty(),
+        "{:?}",
+        others(&d, &["sim", "out.csv"])
+    );
     // A device that is full: a clear error, exit 1.
-    let o = bin().arg("convert").arg(&input).arg("/dev/full").output().unwrap();
+    let o = bin()
+        .arg("convert")
+        .arg(&input)
+        .arg("/dev/full")
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr_of(&o).contains("/dev/full"), "{}", stderr_of(&o));
     let _ = std::fs::remove_dir_all(&d);
@@ -125,7 +141,10 @@ fn a_closed_standard_output_ends_quietly() {
 
 #[test]
 fn a_full_standard_output_is_an_error() {
-    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
     let o = bin()
         .args(["nav", "--print-config"])
         .stdout(full)
@@ -133,7 +152,10 @@ fn a_full_standard_output_is_an_error() {
         .unwrap();
     assert_eq!(o.status.code(), Some(1), "{}", stderr_of(&o));
     let e = stderr_of(&o);
-    assert!(e.contains("standard output") && !e.contains("panicked"), "{e}");
+    assert!(
+        e.contains("standard output") && !e.contains("panicked"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -158,7 +180,11 @@ fn a_folder_with_another_run_needs_force() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(1));
-    assert!(stderr_of(&o).contains("already holds files"), "{}", stderr_of(&o));
+    assert!(
+        stderr_of(&o).contains("already holds files"),
+        "{}",
+        stderr_of(&o)
+    );
     let _ = std::fs::remove_dir_all(&d);
 }
 
@@ -190,7 +216,9 @@ fn a_kill_mid_write_leaves_old_or_complete_files() {
     for trial in 0..12 {
         let run = d.join(format!("run{trial}"));
         simulate(&run, 1);
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         let delay_ms = 20 + (state >> 33) % 250;
         let mut child = bin()
             .args(["simulate", "--json", "--force", "--seed", "2", "--out"])
@@ -242,5 +270,27 @@ fn a_cut_driftless_csv_is_an_error() {
             && !e.contains("panicked"),
         "{e}"
     );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Finite values so large that the Allan sums would overflow are refused with the reason,
+/// not reported as `inf` (text) or `null` (JSON) with exit 0.
+#[test]
+fn values_that_would_overflow_the_sums_are_refused() {
+    let d = scratch("huge");
+    let log = d.join("huge.csv");
+    let rows: String = (0..2000)
+        .map(|i| format!("{},{:e}\n", i as f64 * 0.01, (1.0 + (i % 7) as f64) * 1e154))
+        .collect();
+    std::fs::write(&log, format!("time,gx\n{rows}")).unwrap();
+    for extra in [&[][..], &["--no-fit"], &["--no-fit", "--json"]] {
+        let mut cmd = bin();
+        cmd.arg("allan").arg(&log).args(extra);
+        let o = cmd.output().unwrap();
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(o.status.code(), Some(1), "{out}");
+        assert!(!out.contains("inf") && !out.contains("null"), "{out}");
+        assert!(stderr_of(&o).contains("rescale"), "{}", stderr_of(&o));
+    }
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -142,7 +142,10 @@ mod tests {
             let hard = d.join("hard.csv");
             std::fs::hard_link(&log, &hard).unwrap();
             let msg = refuse_same_file(&link, [&log]).unwrap_err().to_string();
-            assert!(msg.contains("link.csv") && msg.contains("is the input"), "{msg}");
+            assert!(
+                msg.contains("link.csv") && msg.contains("is the input"),
+                "{msg}"
+            );
             assert!(refuse_same_file(&hard, [&log]).is_err());
             assert!(refuse_same_file("/dev/null", ["/dev/null"]).is_ok());
         }
@@ -161,7 +164,10 @@ mod tests {
         std::fs::write(d.join("imu.csv"), "x").unwrap();
         std::fs::write(d.join("gnss.txt"), "x").unwrap();
         let msg = refuse_folder_in_use(&d, false).unwrap_err().to_string();
-        assert!(msg.contains("gnss.txt and 1 more") && msg.contains("--force"), "{msg}");
+        assert!(
+            msg.contains("gnss.txt and 1 more") && msg.contains("--force"),
+            "{msg}"
+        );
         assert!(refuse_folder_in_use(&d, true).is_ok());
         std::fs::remove_dir_all(&d).unwrap();
     }
