@@ -1,6 +1,8 @@
 //! What happens around a run when things go wrong: outputs that are inputs, writes that
 //! fail half-way, a closed or full standard output, a process killed mid-write. Every
 //! earlier file must survive, and nothing partial may sit under a final name.
+//! (Unix: the tests use `sh`, `ulimit`, `/dev/full` and symbolic links.)
+#![cfg(unix)]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -291,6 +293,78 @@ fn values_that_would_overflow_the_sums_are_refused() {
         assert_eq!(o.status.code(), Some(1), "{out}");
         assert!(!out.contains("inf") && !out.contains("null"), "{out}");
         assert!(stderr_of(&o).contains("rescale"), "{}", stderr_of(&o));
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `kill -9` at random instants of `nav --kf-gins` over an earlier run's files: each of
+/// KF-GINS's three files is the earlier one, the complete new one, or absent (the moment
+/// between removing the old file and renaming the new one) — never partial.
+#[test]
+fn a_kill_mid_kf_gins_run_leaves_old_complete_or_no_files() {
+    let d = scratch("killnav");
+    let sim = d.join("sim");
+    simulate(&sim, 1);
+    let cfg = std::fs::read_to_string(sim.join("kf-gins.yaml")).unwrap();
+    let out = sim.join("kf-gins-out");
+    let names = [
+        "KF_GINS_Navresult.nav",
+        "KF_GINS_IMU_ERR.txt",
+        "KF_GINS_STD.txt",
+    ];
+    let run = |yaml: &str| {
+        std::fs::write(sim.join("run.yaml"), yaml).unwrap();
+        let o = bin()
+            .current_dir(&sim)
+            .args(["nav", "--kf-gins", "run.yaml", "--json"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr_of(&o));
+        names.map(|n| std::fs::read(out.join(n)).unwrap())
+    };
+    // The earlier run: the first 60 s only.
+    let start: f64 = cfg
+        .lines()
+        .find_map(|l| l.strip_prefix("starttime:"))
+        .and_then(|v| v.split('#').next())
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap();
+    let short = cfg.replace("endtime: -1", &format!("endtime: {}", start + 60.0));
+    let old = run(&short);
+    let new = run(&cfg);
+    assert!(old[0] != new[0]);
+    let mut state = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .subsec_nanos() as u64
+        | 1;
+    for trial in 0..12 {
+        for (n, bytes) in names.iter().zip(&old) {
+            std::fs::write(out.join(n), bytes).unwrap();
+        }
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let delay_ms = 5 + (state >> 33) % 90;
+        let mut child = bin()
+            .current_dir(&sim)
+            .args(["nav", "--kf-gins", "kf-gins.yaml", "--json"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        let _ = child.kill();
+        let status = child.wait().unwrap();
+        for (k, n) in names.iter().enumerate() {
+            if let Ok(got) = std::fs::read(out.join(n)) {
+                assert!(
+                    got == old[k] || got == new[k],
+                    "trial {trial} ({delay_ms} ms, {status}): {n} is neither the old nor the new file ({} bytes)",
+                    got.len()
+                );
+            }
+        }
     }
     let _ = std::fs::remove_dir_all(&d);
 }
