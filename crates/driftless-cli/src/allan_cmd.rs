@@ -367,6 +367,10 @@ pub fn analyse_log_with(
 }
 
 pub fn run(a: AllanArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(
+        &[a.save_model.as_deref(), a.plot.as_deref()],
+        &[Some(&a.file)],
+    )?;
     let cfg = analysis_config(&a)?;
     let fit = if a.no_fit {
         None
@@ -416,14 +420,14 @@ pub fn run(a: AllanArgs) -> Result<()> {
         crate::demo_cmd::write_plot(p, &out, &a.file.display().to_string())?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&json_output(&out))?);
+        outln!("{}", serde_json::to_string_pretty(&json_output(&out))?);
     } else {
-        print!("{}", human_output(&out, &log, &a.file));
+        out!("{}", human_output(&out, &log, &a.file));
         if let Some(p) = &a.plot {
-            println!("plot written to {}", p.display());
+            outln!("plot written to {}", p.display());
         }
         if let Some(p) = &a.save_model {
-            println!("noise model written to {}", p.display());
+            outln!("noise model written to {}", p.display());
         }
     }
     Ok(())

@@ -310,17 +310,11 @@ fn nav_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
             std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
             let cols = driftless::nav::pipeline::increment_columns(&incs);
             let imu_file = dir.join("imu.txt");
-            write_kfgins_imu(
-                std::io::BufWriter::new(std::fs::File::create(&imu_file)?),
-                "imu.txt",
-                &cols,
-            )?;
+            bench_input(&imu_file, |w| Ok(write_kfgins_imu(w, "imu.txt", &cols)?))?;
             let imu_mb = std::fs::metadata(&imu_file)?.len() as f64 / 1e6;
-            write_kfgins_gnss(
-                std::io::BufWriter::new(std::fs::File::create(dir.join("gnss.txt"))?),
-                "gnss.txt",
-                &g,
-            )?;
+            bench_input(&dir.join("gnss.txt"), |w| {
+                Ok(write_kfgins_gnss(w, "gnss.txt", &g)?)
+            })?;
             let e0 = driftless::nav::attitude::Euler::from_dcm(&start.q_bn.to_dcm());
             let yaml = format!(
                 "imupath: \"{}\"\ngnsspath: \"{}\"\noutputpath: \"{}\"\nimudatalen: 7\n\
@@ -346,7 +340,7 @@ fn nav_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
                 e0.yaw_rad.to_degrees()
             );
             let cfg_path = dir.join("kf-gins.yaml");
-            std::fs::write(&cfg_path, yaml)?;
+            driftless::io::output::write(&cfg_path, yaml)?;
             let (kbest, kmed) = time_runs(a.runs.min(3), || {
                 driftless::nav::kfgins_job::run_kf_gins_job(&cfg_path, &Default::default())
                     .map(|_| ())
@@ -535,7 +529,7 @@ fn print_results(a: &BenchArgs, results: &Results) -> Result<()> {
             .iter()
             .map(|(w, b, m, note)| serde_json::json!({"what": w, "best_s": b, "median_s": m, "note": note}))
             .collect();
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         let mut t = crate::output::Table::new(["benchmark", "best [s]", "median [s]", "note"]);
         for (w, b, m, note) in results {
@@ -546,8 +540,8 @@ fn print_results(a: &BenchArgs, results: &Results) -> Result<()> {
                 note.clone(),
             ]);
         }
-        print!("{}", t.render());
-        println!(
+        out!("{}", t.render());
+        outln!(
             "machine: {} cores (rayon threads: {})",
             std::thread::available_parallelism()
                 .map(|n| n.get())
@@ -558,12 +552,27 @@ fn print_results(a: &BenchArgs, results: &Results) -> Result<()> {
     Ok(())
 }
 
+/// Writes one generated input file through a buffer (not synced: it is read back at once).
+fn bench_input(
+    path: &std::path::Path,
+    body: impl FnOnce(std::io::BufWriter<&mut driftless::io::output::AtomicFile>) -> Result<()>,
+) -> Result<()> {
+    let mut f = driftless::io::output::AtomicFile::create(path)
+        .with_context(|| format!("creating {}", path.display()))?
+        .durable(false);
+    body(std::io::BufWriter::new(&mut f))?;
+    f.commit()
+        .with_context(|| format!("writing {}", path.display()))
+}
+
 /// The CSV a data logger writes: time to 0.01 s, samples with 7 significant digits
 /// (a 16-bit MEMS output carries about 5), as in the issue's ~650 MB 18-h log.
 fn write_logger_csv(log: &ImuLog, path: &std::path::Path) -> Result<()> {
     use std::io::Write;
-    let f = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
+    let mut f = driftless::io::output::AtomicFile::create(path)
+        .with_context(|| format!("creating {}", path.display()))?
+        .durable(false);
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, &mut f);
     let names: Vec<&str> = log.channels.iter().map(|c| c.name.as_str()).collect();
     writeln!(w, "time,{}", names.join(","))?;
     let t = log.time_s.as_deref().unwrap_or(&[]);
@@ -579,5 +588,7 @@ fn write_logger_csv(log: &ImuLog, path: &std::path::Path) -> Result<()> {
         w.write_all(b"\n")?;
     }
     w.flush()?;
-    Ok(())
+    drop(w);
+    f.commit()
+        .with_context(|| format!("writing {}", path.display()))
 }

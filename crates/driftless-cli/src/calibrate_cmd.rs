@@ -191,6 +191,10 @@ fn raw_unit(log: &ImuLog, q: Quantity) -> String {
 }
 
 fn multi(m: MultiArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(
+        &[m.common.out.as_deref(), m.common.plot.as_deref()],
+        &[Some(&m.accel), m.gyro.as_deref()],
+    )?;
     let g = gravity(&m.common)?;
     let acc_log = read(&m.common.input, &m.accel)?;
     let (accel, gyro, gyro_log) = match &m.gyro {
@@ -398,6 +402,10 @@ fn multi(m: MultiArgs) -> Result<()> {
 }
 
 fn six(s: SixArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(
+        &[s.common.out.as_deref(), s.common.plot.as_deref()],
+        &[Some(&s.log), s.manifest.as_deref()],
+    )?;
     let log = read(&s.common.input, &s.log)?;
     let (manifest, temp, source, segmentation) = match &s.manifest {
         Some(path) => {
@@ -640,24 +648,24 @@ fn output(
         if let (Some(obj), serde_json::Value::Object(more)) = (v.as_object_mut(), extra) {
             obj.extend(more);
         }
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
     let mut tab = crate::output::Table::new(residuals.0);
     for row in residuals.1 {
         tab.row(row);
     }
-    println!("residuals of the calibrated accelerometer per static interval:");
-    print!("{}", tab.render());
-    println!();
+    outln!("residuals of the calibrated accelerometer per static interval:");
+    out!("{}", tab.render());
+    outln!();
     for (k, v) in summary {
-        println!("{k}: {v}");
+        outln!("{k}: {v}");
     }
     for (name, t, unit) in [
         ("accelerometer", &file.accel, "m/s²"),
         ("gyro", &file.gyro, "rad/s"),
     ] {
-        println!(
+        outln!(
             "\n{name}: calibrated [{unit}] = M · (raw − b); raw unit: {}",
             t.raw_unit
         );
@@ -684,10 +692,10 @@ fn output(
                 ),
             ]);
         }
-        print!("{}", tab.render());
+        out!("{}", tab.render());
     }
     for p in [&c.out, &c.plot].into_iter().flatten() {
-        println!("\nwrote {}", p.display());
+        outln!("\nwrote {}", p.display());
     }
     Ok(())
 }

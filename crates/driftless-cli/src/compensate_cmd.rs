@@ -93,6 +93,7 @@ pub fn warn_out_of_range(
 }
 
 pub fn run(a: CompensateArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(&[Some(&a.out)], &[Some(&a.log), Some(&a.model)])?;
     let (file, model) = ThermalModelFile::load(&a.model)?;
     for (t, si) in [
         (&file.accel, ["m/s^2", "m/s²"]),
@@ -178,7 +179,7 @@ pub fn run(a: CompensateArgs) -> Result<()> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
             (a.min(t), b.max(t))
         });
-    println!(
+    outln!(
         "{}: {n} samples at {lo:.2}–{hi:.2} °C compensated with model {:#x} (valid {:?} °C, {}{}) in {:.3} s → {}",
         a.log.display(),
         model.id(),

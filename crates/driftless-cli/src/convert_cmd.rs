@@ -47,6 +47,7 @@ fn log_output_path(s: &str) -> Result<PathBuf, String> {
 
 pub fn run(a: ConvertArgs) -> Result<()> {
     let format = log_format(&a.output).context("output name ends in neither .dlog nor .csv")?;
+    crate::paths::refuse_outputs_over_inputs(&[Some(&a.output)], &[Some(&a.input)])?;
     let log = crate::allan_cmd::read_with_progress(&a.read, &a.input, false)?;
     match format {
         LogFormat::Text => driftless::io::write_csv_file(&log, &a.output),

@@ -102,7 +102,7 @@ pub fn demo_truth(rate_hz: f64, duration_s: f64) -> Vec<(String, Quantity, Stati
 
 pub fn run(a: DemoArgs) -> Result<()> {
     if a.print_scenario {
-        print!("{}", driftless::experiment::scenario::BUILTIN_ADI_LIKE);
+        out!("{}", driftless::experiment::scenario::BUILTIN_ADI_LIKE);
         return Ok(());
     }
     if !a.noise {
@@ -185,31 +185,34 @@ fn noise_demo(a: DemoArgs) -> Result<()> {
     if let Some(m) = &out.noise {
         m.save(&model_path)?;
     }
-    std::fs::write(
+    driftless::io::output::write(
         a.out.join("allan.json"),
         serde_json::to_string_pretty(&json_output(&out))?,
     )?;
 
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&json_output(&out))?);
+        outln!("{}", serde_json::to_string_pretty(&json_output(&out))?);
         return Ok(());
     }
-    println!(
+    outln!(
         "driftless demo — simulated static six-axis IMU, {:.1} h at {} Hz ({} samples/axis), seed {}\n",
-        a.hours, a.rate, n, a.seed
+        a.hours,
+        a.rate,
+        n,
+        a.seed
     );
-    print!("{}", truth_table(&truth, &out));
-    println!();
+    out!("{}", truth_table(&truth, &out));
+    outln!();
     if let Some(m) = &out.noise {
-        print!("{}", m.human_table());
+        out!("{}", m.human_table());
     }
-    println!(
+    outln!(
         "\ntimings: simulation {:.2} s, OADEV + CI + fit {:.2} s, total {:.2} s",
         t_sim.as_secs_f64(),
         t_allan.as_secs_f64(),
         t_all.elapsed().as_secs_f64()
     );
-    println!(
+    outln!(
         "wrote {}, {}, {}",
         plot_path.display(),
         model_path.display(),

@@ -49,7 +49,7 @@ pub fn run_scenario(
     sp.finish_and_clear();
     let k = runs.unwrap_or(p.scenario.monte_carlo.runs);
     if show {
-        println!(
+        outln!(
             "{} — {} outage(s) of {}; {} run(s)",
             p.scenario.title.as_deref().unwrap_or(&p.scenario.name),
             p.outages.len(),
@@ -90,21 +90,21 @@ pub fn run_scenario(
     runs_bar.finish_and_clear();
     let written = write_outputs(out, &p, &result)?;
     if json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&ExperimentDocument::new(&p, &result))?
         );
         return Ok(());
     }
     print_human(&p, &result);
-    println!(
+    outln!(
         "\nwrote {} files to {} in {:.1} s",
         written.len(),
         out.display(),
         t_all.elapsed().as_secs_f64()
     );
     for w in &written {
-        println!("  {}", w.display());
+        outln!("  {}", w.display());
     }
     Ok(())
 }
@@ -115,19 +115,19 @@ pub fn run(a: ExperimentArgs) -> Result<()> {
 }
 
 fn print_human(p: &Prepared, r: &ExperimentResult) {
-    println!();
+    outln!();
     for col in [Column::ForwardEnd, Column::SmoothedMax] {
         let (h, rows) = table_rows(p, &r.detailed, col);
-        println!("Table 1 (run 0): {}", col.title());
+        outln!("Table 1 (run 0): {}", col.title());
         let mut t = crate::output::Table::new(h);
         for row in rows {
             t.row(row);
         }
-        print!("{}", t.render());
-        println!();
+        out!("{}", t.render());
+        outln!();
     }
     let s = &r.summary;
-    println!(
+    outln!(
         "Monte Carlo over {} run(s): mean end-of-outage horizontal error per run, forward filter [m]",
         s.runs
     );
@@ -136,24 +136,25 @@ fn print_human(p: &Prepared, r: &ExperimentResult) {
     for row in rows {
         t.row(row);
     }
-    print!("{}", t.render());
+    out!("{}", t.render());
     for c in &s.cases {
         if let Some(m) = &c.first_failure {
-            println!(
+            outln!(
                 "{}: failed in {} run(s), first: {m}",
-                c.label, c.failed_runs
+                c.label,
+                c.failed_runs
             );
         }
     }
-    println!();
+    outln!();
     for line in ratio_explanation(p, r) {
-        println!("{line}");
+        outln!("{line}");
     }
     let reversals = reversal_explanation(r);
     if !reversals.is_empty() {
-        println!();
+        outln!();
         for line in reversals {
-            println!("{line}");
+            outln!("{line}");
         }
     }
 }
@@ -178,7 +179,7 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
         md.push_str(&markdown(&h, &rows));
         md.push('\n');
         let path = out.join(file);
-        std::fs::write(&path, csv(&h, &rows))
+        driftless::io::output::write(&path, csv(&h, &rows))
             .with_context(|| format!("writing {}", path.display()))?;
         written.push(path);
     }
@@ -193,7 +194,8 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
         md.push_str("\n\n");
     }
     let path = out.join("table1.md");
-    std::fs::write(&path, md).with_context(|| format!("writing {}", path.display()))?;
+    driftless::io::output::write(&path, md)
+        .with_context(|| format!("writing {}", path.display()))?;
     written.push(path);
     let figs = driftless::experiment::report::figures(p, r);
     let fig_dir = out.join("figures");
@@ -210,7 +212,7 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
         .with_context(|| format!("writing {}", path.display()))?;
     written.push(path);
     let path = out.join("experiment.json");
-    std::fs::write(
+    driftless::io::output::write(
         &path,
         serde_json::to_string_pretty(&ExperimentDocument::new(p, r))?,
     )

@@ -6,6 +6,9 @@
 //! `simulate` (scenario → IMU, GNSS and truth files), `calibrate`, `thermal`,
 //! `compensate`.
 
+#[macro_use]
+mod stdout;
+
 mod allan_cmd;
 mod bench_cmd;
 mod calibrate_cmd;
@@ -16,6 +19,7 @@ mod experiment_cmd;
 mod input;
 mod nav_cmd;
 mod output;
+mod paths;
 mod segment_view;
 mod simulate_cmd;
 mod thermal_cmd;
@@ -65,7 +69,32 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        run(cli.command)?;
+        stdout::flush().map_err(|e| anyhow::Error::new(stdout::StdoutFailed(e)))
+    }));
+    let result = match result {
+        Ok(r) => r,
+        Err(payload) => match payload.downcast::<stdout::StdoutFailed>() {
+            Ok(failed) => Err(anyhow::Error::new(*failed)),
+            Err(other) => std::panic::resume_unwind(other),
+        },
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => match e.downcast_ref::<stdout::StdoutFailed>() {
+            // The reader has gone (`| head`): nothing left to say to anyone.
+            Some(f) if f.0.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+            _ => {
+                eprintln!("error: {}", error_chain(&e));
+                ExitCode::from(1)
+            }
+        },
+    }
+}
+
+fn run(command: Command) -> anyhow::Result<()> {
+    match command {
         Command::Allan(a) => allan_cmd::run(a),
         Command::Convert(a) => convert_cmd::run(a),
         Command::Calibrate(a) => calibrate_cmd::run(a),
@@ -76,13 +105,6 @@ fn main() -> ExitCode {
         Command::Nav(a) => nav_cmd::run(a),
         Command::Simulate(a) => simulate_cmd::run(a),
         Command::Thermal(a) => thermal_cmd::run(a),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {}", error_chain(&e));
-            ExitCode::from(1)
-        }
     }
 }
 

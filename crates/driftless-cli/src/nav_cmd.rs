@@ -118,9 +118,14 @@ pub struct NavArgs {
     /// the configuration in effect) and exit.
     #[arg(long)]
     pub print_config: bool,
-    /// Folder for KF-GINS-format output files.
+    /// Folder for KF-GINS-format output files (refused when it already holds files,
+    /// unless --force).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Write --out into a folder that already holds files (this run's three files replace
+    /// theirs).
+    #[arg(long)]
+    pub force: bool,
     /// Also write the solution as CSV (time, lat/lon in deg, height, NED velocity, roll/pitch/yaw in deg).
     #[arg(long, value_name = "FILE")]
     pub csv: Option<PathBuf>,
@@ -191,14 +196,27 @@ pub fn run(a: NavArgs) -> Result<()> {
     }
     if a.print_config {
         if a.config.is_none() && a.preset.is_none() && a.settings.overrides.is_empty() {
-            print!("{}", NavConfig::default_toml());
+            out!("{}", NavConfig::default_toml());
         } else {
             let c = load_config(&a)?;
-            print!("{}", toml::to_string_pretty(&c.config)?);
+            out!("{}", toml::to_string_pretty(&c.config)?);
         }
         return Ok(());
     }
     let cfg = load_config(&a)?;
+    if let Some(dir) = &a.out {
+        driftless::io::output::refuse_folder_in_use(dir, a.force)?;
+    }
+    let imu_file = (cfg.config.imu.file.as_deref()).map(|p| cfg.path("imu.file", p));
+    let gnss_file = (cfg.config.gnss.file.as_deref()).map(|p| cfg.path("gnss.file", p));
+    crate::paths::refuse_outputs_over_inputs(
+        &[a.csv.as_deref(), a.geojson.as_deref()],
+        &[
+            a.config.as_deref(),
+            imu_file.as_deref(),
+            gnss_file.as_deref(),
+        ],
+    )?;
     // Navigation needs time stamps: the first column unless told otherwise.
     let mut input = a.input.clone();
     input.time_column.get_or_insert_with(|| "1".into());
@@ -276,10 +294,10 @@ pub fn run(a: NavArgs) -> Result<()> {
             })).collect::<Vec<_>>()),
             "notes": job.notes,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{} IMU epochs at {:.1} Hz ({:?}), {} GNSS fixes in the IMU span; filter started at {:.2} s",
         job.imu.len(),
         1.0 / job.imu.nominal_dt_s,
@@ -287,22 +305,26 @@ pub fn run(a: NavArgs) -> Result<()> {
         job.fixes.time_s.len(),
         res.init.nav.time_s,
     );
-    println!(
+    outln!(
         "GNSS: {} accepted, {} rejected by the gate, {} withheld by outages, {} dropped by the quality filter",
-        run.gnss_accepted, run.gnss_rejected, run.gnss_withheld, job.dropped_by_quality
+        run.gnss_accepted,
+        run.gnss_rejected,
+        run.gnss_withheld,
+        job.dropped_by_quality
     );
     if sc.auto_sigma_floor {
         println!("{}", floor_summary(&res.sigma_floors));
     }
     if let Some((rms, n)) = res.horizontal_rms_m {
-        println!(
+        outln!(
             "full-GNSS horizontal one-step prediction error: RMS {rms:.3} m over {n} fixes \
              (not counting {:.0} s after the start and {:.0} s after each outage)",
-            sc.converge_s, sc.reconverge_s
+            sc.converge_s,
+            sc.reconverge_s
         );
     }
     if let Some(sel) = &job.selection {
-        print!("{}", selection_table(sel));
+        out!("{}", selection_table(sel));
     }
     if !res.outages.is_empty() {
         let mut t = crate::output::Table::new([
@@ -328,21 +350,21 @@ pub fn run(a: NavArgs) -> Result<()> {
                 sm,
             ]);
         }
-        print!("{}", t.render());
-        println!(
+        out!("{}", t.render());
+        outln!(
             "fixes withheld in (s, e]. ¹ horizontal error of the forward filter at the first fix after e \
              (its prediction against that fix); ² largest horizontal error at the IMU epochs in (s, e] \
              against the fixes interpolated linearly"
         );
         if let Some(m) = mean_end {
-            println!(
+            outln!(
                 "mean end-of-outage horizontal error {m:.2} m over {} outages",
                 ends.len()
             );
         }
     }
     if let Some(dir) = &a.out {
-        println!("KF-GINS-format outputs written to {}", dir.display());
+        outln!("KF-GINS-format outputs written to {}", dir.display());
     }
     Ok(())
 }
@@ -452,7 +474,7 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
         .chain(job.smoothed_files.iter().flatten())
         .collect();
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "epochs": job.rows,
@@ -465,7 +487,7 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
             }))?
         );
     } else {
-        println!(
+        outln!(
             "{}: {} epochs written from {:.3} s, GNSS {} accepted, {} rejected, {} withheld, {} skipped",
             path.display(),
             job.rows,
@@ -476,7 +498,7 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
             run.gnss_skipped
         );
         for f in files {
-            println!("wrote {}", f.display());
+            outln!("wrote {}", f.display());
         }
     }
     Ok(())

@@ -94,7 +94,7 @@ fn segment(log: &ImuLog, path: &Path, a: &SegmentArgs, nominal_c: f64) -> Result
 
 /// The segmentation as tables (segments, plateaus, findings).
 fn print_table(seg: &Segmentation, path: &Path) {
-    println!(
+    outln!(
         "segmentation of {} ({} samples at {} Hz, no manifest):",
         path.display(),
         seg.n_samples,
@@ -160,7 +160,7 @@ fn print_table(seg: &Segmentation, path: &Path) {
     for (_, r) in rows {
         tab.row(r);
     }
-    print!("{}", tab.render());
+    out!("{}", tab.render());
     let mut tab = crate::output::Table::new([
         "plateau",
         "start [s]",
@@ -191,16 +191,16 @@ fn print_table(seg: &Segmentation, path: &Path) {
                 .join(" "),
         ]);
     }
-    print!("{}", tab.render());
+    out!("{}", tab.render());
     if seg.findings.is_empty() {
-        println!("findings: none");
+        outln!("findings: none");
     } else {
-        println!("findings:");
+        outln!("findings:");
         for f in &seg.findings {
-            println!("  {:.2}–{:.2} s: {}", f.start_s, f.end_s, f.message);
+            outln!("  {:.2}–{:.2} s: {}", f.start_s, f.end_s, f.message);
         }
     }
-    println!();
+    outln!();
 }
 
 /// The segmentation as JSON.

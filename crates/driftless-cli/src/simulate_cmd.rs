@@ -16,6 +16,7 @@ use clap::Args;
 use driftless::io::nav::{
     KfGinsConfigRaw, write_kfgins_gnss, write_kfgins_imu, write_kfgins_nav, write_rtklib_pos,
 };
+use driftless::io::output::AtomicFile;
 use driftless::sim::scenario::{Scenario, Simulation, euler_of};
 use driftless_model::units::{DEG_PER_H, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H};
 use std::io::BufWriter;
@@ -29,6 +30,11 @@ pub struct SimulateArgs {
     /// Output folder (default: the scenario's `[output] dir`, else `sim-out`).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Write into an output folder that already holds files: this run's files replace
+    /// theirs, and files an earlier simulation wrote that this run does not are removed.
+    /// Without it such a folder is refused, so that runs never mix.
+    #[arg(long)]
+    pub force: bool,
     /// Override the scenario's seed.
     #[arg(long)]
     pub seed: Option<u64>,
@@ -43,6 +49,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         sc.seed = s;
     }
     let dir = a.out.clone().unwrap_or_else(|| sc.output.dir.clone());
+    driftless::io::output::refuse_folder_in_use(&dir, a.force)?;
     let pb = crate::demo_cmd::spinner(!a.json, format!("simulating {}", a.scenario.display()));
     let t = Instant::now();
     let sim = sc.run()?;
@@ -51,11 +58,12 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     let t = Instant::now();
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let files = write_outputs(&sim, &sc, &dir)?;
+    remove_stale_outputs(&dir, &files)?;
     let write_s = t.elapsed().as_secs_f64();
     pb.finish_and_clear();
     let n_fix = sim.gnss.as_ref().map_or(0, |g| g.len());
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "imu_samples": sim.imu.len(),
@@ -69,7 +77,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
             }))?
         );
     } else {
-        println!(
+        outln!(
             "{}: {} IMU samples at {} Hz ({:.1} s), {} GNSS fixes, {} outage windows; seed {}",
             a.scenario.display(),
             sim.imu.len(),
@@ -79,9 +87,9 @@ pub fn run(a: SimulateArgs) -> Result<()> {
             sim.gnss_outages_s.len(),
             sc.seed
         );
-        println!("simulated in {sim_s:.2} s, written in {write_s:.2} s:");
+        outln!("simulated in {sim_s:.2} s, written in {write_s:.2} s:");
         for f in &files {
-            println!("  {}", f.display());
+            outln!("  {}", f.display());
         }
     }
     Ok(())
@@ -89,10 +97,14 @@ pub fn run(a: SimulateArgs) -> Result<()> {
 
 fn write_outputs(sim: &Simulation, sc: &Scenario, dir: &Path) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
-    let create = |name: &str| -> Result<(BufWriter<std::fs::File>, PathBuf)> {
+    let create = |name: &str| -> Result<(AtomicFile, PathBuf)> {
         let p = dir.join(name);
-        let f = std::fs::File::create(&p).with_context(|| format!("creating {}", p.display()))?;
-        Ok((BufWriter::with_capacity(1 << 20, f), p))
+        let f = AtomicFile::create(&p).with_context(|| format!("creating {}", p.display()))?;
+        Ok((f, p))
+    };
+    let commit = |f: AtomicFile, p: &Path| -> Result<()> {
+        f.commit()
+            .with_context(|| format!("writing {}", p.display()))
     };
     let source = format!("driftless simulate {}", sc.name);
     // The big files are independent: write them concurrently.
@@ -104,11 +116,13 @@ fn write_outputs(sim: &Simulation, sc: &Scenario, dir: &Path) -> Result<Vec<Path
         },
         || -> Result<Vec<PathBuf>> {
             let mut out = Vec::new();
-            let (w, p) = create("imu.txt")?;
-            write_kfgins_imu(w, &p.display().to_string(), &sim.increments())?;
+            let (mut f, p) = create("imu.txt")?;
+            write_kfgins_imu(buf(&mut f), &p.display().to_string(), &sim.increments())?;
+            commit(f, &p)?;
             out.push(p);
-            let (w, p) = create("truth.nav")?;
-            write_kfgins_nav(w, &p.display().to_string(), &sim.truth, 0)?;
+            let (mut f, p) = create("truth.nav")?;
+            write_kfgins_nav(buf(&mut f), &p.display().to_string(), &sim.truth, 0)?;
+            commit(f, &p)?;
             out.push(p);
             Ok(out)
         },
@@ -116,20 +130,22 @@ fn write_outputs(sim: &Simulation, sc: &Scenario, dir: &Path) -> Result<Vec<Path
     files.push(csv?);
     files.extend(kf?);
     if let Some(g) = &sim.gnss {
-        let (w, p) = create("gnss.txt")?;
-        write_kfgins_gnss(w, &p.display().to_string(), g)?;
+        let (mut f, p) = create("gnss.txt")?;
+        write_kfgins_gnss(buf(&mut f), &p.display().to_string(), g)?;
+        commit(f, &p)?;
         files.push(p);
-        let (w, p) = create("gnss.pos")?;
-        write_rtklib_pos(w, &p.display().to_string(), g, &source)?;
+        let (mut f, p) = create("gnss.pos")?;
+        write_rtklib_pos(buf(&mut f), &p.display().to_string(), g, &source)?;
+        commit(f, &p)?;
         files.push(p);
         let p = dir.join("kf-gins.yaml");
-        std::fs::write(&p, kfgins_config(sim).to_yaml())
+        driftless::io::output::write(&p, kfgins_config(sim).to_yaml())
             .with_context(|| format!("writing {}", p.display()))?;
         files.push(p);
     }
     if let Some(m) = &sim.manifest {
         let p = dir.join("manifest.toml");
-        std::fs::write(&p, m.to_toml_string()?)
+        driftless::io::output::write(&p, m.to_toml_string()?)
             .with_context(|| format!("writing {}", p.display()))?;
         files.push(p);
     }
@@ -142,9 +158,39 @@ fn write_outputs(sim: &Simulation, sc: &Scenario, dir: &Path) -> Result<Vec<Path
         sim.imu.accel_turn_on_bias_m_s2,
         toml::to_string(&sim.sensor).context("serialising the sensor configuration")?
     );
-    std::fs::write(&p, text).with_context(|| format!("writing {}", p.display()))?;
+    driftless::io::output::write(&p, text).with_context(|| format!("writing {}", p.display()))?;
     files.push(p);
     Ok(files)
+}
+
+/// Every file `simulate` may write.
+const OUTPUT_FILES: [&str; 8] = [
+    "imu.csv",
+    "imu.txt",
+    "truth.nav",
+    "gnss.txt",
+    "gnss.pos",
+    "kf-gins.yaml",
+    "manifest.toml",
+    "sensor.toml",
+];
+
+/// Removes the files of an earlier simulation in `dir` that this run (`written`) did not
+/// replace — a GNSS file of another trajectory must not sit beside this run's IMU file.
+fn remove_stale_outputs(dir: &Path, written: &[PathBuf]) -> Result<()> {
+    for name in OUTPUT_FILES {
+        let p = dir.join(name);
+        if written.iter().all(|w| w.file_name() != p.file_name()) && p.is_file() {
+            std::fs::remove_file(&p)
+                .with_context(|| format!("removing {} of an earlier run", p.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// A 1 MiB buffer in front of an output file.
+fn buf(f: &mut AtomicFile) -> BufWriter<&mut AtomicFile> {
+    BufWriter::with_capacity(1 << 20, f)
 }
 
 /// A KF-GINS configuration for the simulated files: the true initial state with small

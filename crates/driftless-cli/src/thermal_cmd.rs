@@ -261,7 +261,7 @@ fn check(c: CheckArgs) -> Result<()> {
         .map(|(label, log)| check_log(log, label, &opts))
         .collect();
     if c.json {
-        println!("{}", serde_json::to_string_pretty(&reports)?);
+        outln!("{}", serde_json::to_string_pretty(&reports)?);
         return Ok(());
     }
     let mut tab = crate::output::Table::new(
@@ -304,16 +304,16 @@ fn check(c: CheckArgs) -> Result<()> {
             r.verdict().to_string(),
         ]);
     }
-    print!("{}", tab.render());
+    out!("{}", tab.render());
     for r in &reports {
-        println!("{}: fit for {}", r.label, r.verdict());
+        outln!("{}: fit for {}", r.label, r.verdict());
         for f in &r.findings {
             let tag = |i: Impact| match i {
                 Impact::Block => "refused",
                 Impact::Warn => "warning",
                 Impact::None => "–",
             };
-            println!(
+            outln!(
                 "  [ramp {}, soak {}] {}",
                 tag(f.ramp),
                 tag(f.soak),
@@ -396,6 +396,14 @@ fn soak_precheck(
 }
 
 fn soak(s: SoakArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(
+        &[s.out.as_deref(), s.plot.as_deref()],
+        &[
+            Some(&s.log),
+            s.manifest.as_deref(),
+            s.noise_model.as_deref(),
+        ],
+    )?;
     let policy = match s.out_of_range.as_str() {
         "clamp" => OutOfRange::Clamp,
         "extrapolate" => OutOfRange::Extrapolate,
@@ -502,7 +510,7 @@ fn soak(s: SoakArgs) -> Result<()> {
                 })
             })
             .collect();
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "temperatures_c": soak.temperatures_c,
@@ -521,7 +529,7 @@ fn soak(s: SoakArgs) -> Result<()> {
         );
         return Ok(());
     }
-    println!(
+    outln!(
         "{} set temperatures {:?} °C; order {} about {} °C; {:.3} s",
         soak.temperatures_c.len(),
         soak.temperatures_c,
@@ -552,8 +560,8 @@ fn soak(s: SoakArgs) -> Result<()> {
         row.push(scatter_cell(&x.fit));
         tab.row(row);
     }
-    print!("{}", tab.render());
-    println!("{SCATTER_NOTE}");
+    out!("{}", tab.render());
+    outln!("{SCATTER_NOTE}");
     if let Some(g) = &g_mean {
         // Estimated per step (rate segments all +k up); the model file carries the mean.
         let d = |i: usize| {
@@ -563,7 +571,7 @@ fn soak(s: SoakArgs) -> Result<()> {
                 crate::output::sci(g.sigma_raw_per_m_s2[i][i])
             )
         };
-        println!(
+        outln!(
             "gyro g-sensitivity (mean over {} steps, per m/s^2): G_xx {}, G_yy {}, G_zz {}",
             soak.gyro_g_sensitivity.len(),
             d(0),
@@ -572,7 +580,7 @@ fn soak(s: SoakArgs) -> Result<()> {
         );
     }
     for p in [&s.out, &s.plot].into_iter().flatten() {
-        println!("wrote {}", p.display());
+        outln!("wrote {}", p.display());
     }
     Ok(())
 }
@@ -596,6 +604,7 @@ fn soak_manifest(
 }
 
 fn ramp(r: RampArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(&[r.out.as_deref()], &[Some(&r.log)])?;
     use driftless::thermal::ramp::{RampOptions, ramp_calibration};
     let mut input = r.input.clone();
     input.time_column.get_or_insert_with(|| "1".into());
@@ -699,7 +708,7 @@ fn ramp(r: RampArgs) -> Result<()> {
                 })
             })
             .collect();
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "bins_heating": heating,
@@ -712,7 +721,7 @@ fn ramp(r: RampArgs) -> Result<()> {
         );
         return Ok(());
     }
-    println!(
+    outln!(
         "{} temperature bins ({heating} heating, {} cooling); order {} about {} °C",
         res.points.len(),
         res.points.len() - heating,
@@ -741,15 +750,19 @@ fn ramp(r: RampArgs) -> Result<()> {
         row.push(scatter_cell(f));
         tab.row(row);
     }
-    print!("{}", tab.render());
-    println!("{SCATTER_NOTE}");
+    out!("{}", tab.render());
+    outln!("{SCATTER_NOTE}");
     if let Some(p) = &r.out {
-        println!("wrote {} (bias-only model)", p.display());
+        outln!("wrote {} (bias-only model)", p.display());
     }
     Ok(())
 }
 
 fn export(e: ExportArgs) -> Result<()> {
+    crate::paths::refuse_outputs_over_inputs(
+        &[e.px4.as_deref(), e.ardupilot.as_deref()],
+        &[Some(&e.model)],
+    )?;
     use driftless::thermal::autopilot::{
         BiasModel, ExportOptions, check_temperatures, compare_ardupilot, compare_px4,
         export_ardupilot, export_px4, parse_ardupilot, parse_px4,
@@ -772,7 +785,8 @@ fn export(e: ExportArgs) -> Result<()> {
     let mut checks = Vec::new();
     if let Some(p) = &e.px4 {
         let text = export_px4(&bm, &opts)?;
-        std::fs::write(p, &text).with_context(|| format!("writing {}", p.display()))?;
+        driftless::io::output::write(p, &text)
+            .with_context(|| format!("writing {}", p.display()))?;
         let back = std::fs::read_to_string(p)?;
         let parsed = parse_px4(&back, &p.display().to_string(), e.instance)?;
         let err = compare_px4(&file, &model, &parsed, &temps, e.no_offsets)?;
@@ -780,7 +794,8 @@ fn export(e: ExportArgs) -> Result<()> {
     }
     if let Some(p) = &e.ardupilot {
         let text = export_ardupilot(&bm, &opts)?;
-        std::fs::write(p, &text).with_context(|| format!("writing {}", p.display()))?;
+        driftless::io::output::write(p, &text)
+            .with_context(|| format!("writing {}", p.display()))?;
         let back = std::fs::read_to_string(p)?;
         let mut parsed = parse_ardupilot(&back, &p.display().to_string(), e.instance)?;
         if e.no_offsets {
@@ -809,7 +824,7 @@ fn export(e: ExportArgs) -> Result<()> {
                 })
             })
             .collect();
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "model_id": file.model_id,
@@ -824,7 +839,7 @@ fn export(e: ExportArgs) -> Result<()> {
         );
     } else {
         for (ap, p, c) in &checks {
-            println!(
+            outln!(
                 "wrote {} ({ap}); read back, max |model − {ap}| over 10 temperatures in \
                  [{}, {}] °C: accel {} m/s², gyro {} rad/s (float32 arithmetic)",
                 p.display(),
@@ -834,14 +849,14 @@ fn export(e: ExportArgs) -> Result<()> {
                 crate::output::sci(c.gyro_f32)
             );
         }
-        println!(
+        outln!(
             "bias only: thermal scale-factor change dropped (max |Δs| accel {}, gyro {}); \
              misalignment and room scale left to the autopilot's own calibration",
             crate::output::sci(ds(&bm.accel)),
             crate::output::sci(ds(&bm.gyro))
         );
         if file.gyro_g_sensitivity.is_some() {
-            println!(
+            outln!(
                 "the model's gyro g-sensitivity is not exported: neither autopilot has a \
                  parameter for it"
             );

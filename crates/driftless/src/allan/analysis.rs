@@ -135,6 +135,16 @@ pub fn analyse_segments(
                 value: seg[i],
             });
         }
+        if let Some(i) = seg
+            .iter()
+            .position(|v| v.abs() > super::MAX_SAMPLE_MAGNITUDE)
+        {
+            return Err(AllanError::OutOfRange {
+                index: offset + i,
+                value: seg[i],
+                limit: super::MAX_SAMPLE_MAGNITUDE,
+            });
+        }
         offset += seg.len();
     }
     // Phase for each segment.

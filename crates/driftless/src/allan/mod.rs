@@ -151,7 +151,24 @@ pub enum AllanError {
         /// Its value.
         value: f64,
     },
+    /// A value so large that the sums of squared differences would overflow to infinity.
+    #[error(
+        "sample {index} is {value:e}, beyond the ±{limit:e} the Allan sums hold without \
+         overflowing; rescale the data (its unit) before the analysis"
+    )]
+    OutOfRange {
+        /// Index of the offending sample.
+        index: usize,
+        /// Its value.
+        value: f64,
+        /// The largest magnitude analysed.
+        limit: f64,
+    },
     /// Invalid parameter.
     #[error("{0}")]
     Invalid(String),
 }
+
+/// The largest sample magnitude analysed: phase (a sum of up to 10⁹ samples times τ0)
+/// squared and summed again stays far below `f64::MAX` (1.8e308).
+pub const MAX_SAMPLE_MAGNITUDE: f64 = 1e100;

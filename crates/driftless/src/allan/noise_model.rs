@@ -621,7 +621,7 @@ impl NoiseModel {
     /// Write the model to `path`.
     pub fn save(&self, path: &Path) -> Result<(), NoiseModelError> {
         let s = self.to_toml_string()?;
-        std::fs::write(path, s).map_err(|e| NoiseModelError::Write {
+        crate::io::output::write(path, s).map_err(|e| NoiseModelError::Write {
             path: path.to_path_buf(),
             source: e,
         })

@@ -191,9 +191,11 @@ impl CalibrationFile {
     /// Writes the file.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), ModelFileError> {
         let path = path.as_ref();
-        std::fs::write(path, self.to_toml_string()?).map_err(|source| ModelFileError::Io {
-            path: path.display().to_string(),
-            source,
+        crate::io::output::write(path, self.to_toml_string()?).map_err(|source| {
+            ModelFileError::Io {
+                path: path.display().to_string(),
+                source,
+            }
         })
     }
 }

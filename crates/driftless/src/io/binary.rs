@@ -66,8 +66,9 @@ struct ChannelHeader {
 
 /// Writes `log` as a binary log to a file.
 pub fn write_binary_file(log: &ImuLog, path: impl AsRef<Path>) -> Result<(), LogError> {
-    let (file, name) = super::error::create_file(path.as_ref())?;
-    write_impl(log, file, &name)
+    let (mut file, name) = super::error::create_file(path.as_ref())?;
+    write_impl(log, &mut file, &name)?;
+    super::error::commit_file(file, &name)
 }
 
 /// Writes `log` as a binary log to any writer (errors name the output `<output>`).

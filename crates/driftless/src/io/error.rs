@@ -277,6 +277,23 @@ pub enum LogError {
         /// What was missing.
         message: String,
     },
+    /// Text log written by driftless: fewer or more data rows than its header states (the
+    /// file was cut at a line end, e.g. by an interrupted write).
+    #[error(
+        "{at}: truncated log: its header says {expected} rows, {found} found, {end_mark} (the \
+         file was cut, e.g. by an interrupted write; to read the rows present, delete the \
+         header's second comment line)"
+    )]
+    RowCountMismatch {
+        /// The input.
+        at: Location,
+        /// Rows the header states.
+        expected: usize,
+        /// Data rows read.
+        found: usize,
+        /// Whether the end mark the header announces is there.
+        end_mark: &'static str,
+    },
     /// Binary log: the data size disagrees with the header's row and column counts.
     #[error(
         "{at}: binary log size mismatch: header says {rows} rows × {columns} columns = {expected_bytes} bytes of data, found {found_bytes}"
@@ -378,6 +395,7 @@ impl LogError {
             | BadHeader { at, .. }
             | Truncated { at, .. }
             | CountMismatch { at, .. }
+            | RowCountMismatch { at, .. }
             | NonFiniteStored { at, .. }
             | Corrupt { at, .. }
             | InvalidLog { at, .. }
@@ -439,12 +457,23 @@ pub(crate) fn open_file(path: &std::path::Path) -> Result<(std::fs::File, u64, S
     Ok((file, size, name))
 }
 
-/// Creates (truncates) `path` for writing: (file, display name); errors name the file.
-pub(crate) fn create_file(path: &std::path::Path) -> Result<(std::fs::File, String), LogError> {
+/// Starts writing `path` atomically ([`crate::io::output::AtomicFile`]): (file, display
+/// name); errors name the file. [`commit_file`] puts it under its final name.
+pub(crate) fn create_file(
+    path: &std::path::Path,
+) -> Result<(crate::io::output::AtomicFile, String), LogError> {
     let name = path.display().to_string();
-    let file = std::fs::File::create(path).map_err(|error| LogError::Io {
+    let file = crate::io::output::AtomicFile::create(path).map_err(|error| LogError::Io {
         path: name.clone(),
         error,
     })?;
     Ok((file, name))
+}
+
+/// Flushes, syncs and renames a file from [`create_file`] over its final name.
+pub(crate) fn commit_file(file: crate::io::output::AtomicFile, name: &str) -> Result<(), LogError> {
+    file.commit().map_err(|error| LogError::Io {
+        path: name.to_owned(),
+        error,
+    })
 }

@@ -8,6 +8,7 @@
 //!   ULog and ArduPilot DataFlash logs → one [`log::ImuLog`] per IMU instance.
 //! * [`units`]: unit strings → SI conversion.
 //! * [`error`]: one error type, [`LogError`], naming file, line and column.
+//! * [`output`]: every output file, written atomically; checks of output paths against inputs.
 //!
 //! OWNER: helper "io" (text, binary, units, errors, fuzzing).
 
@@ -21,6 +22,7 @@ pub mod error;
 pub mod log;
 pub mod nav;
 mod number;
+pub mod output;
 pub mod text;
 #[cfg(feature = "autopilot-logs")]
 pub mod ulog;

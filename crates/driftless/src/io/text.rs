@@ -415,6 +415,22 @@ fn for_each_field<E>(
     Ok(field)
 }
 
+/// What the header of a CSV written by driftless states: a first line
+/// `# driftless log; …` and a second `# …; rows: N[; last line: # end of driftless log]` —
+/// the row count and whether the file ends with that line.
+fn declared_rows(region: &[u8]) -> Option<(usize, bool)> {
+    let mut ls = lines(region);
+    if !ls.next()?.starts_with(super::write::HEADER_MARK.as_bytes()) {
+        return None;
+    }
+    let second = std::str::from_utf8(ls.next()?).ok()?.trim_end();
+    let (_, after) = second.strip_prefix('#')?.split_once("rows: ")?;
+    let digits = after.bytes().take_while(u8::is_ascii_digit).count();
+    let n = after[..digits].parse().ok()?;
+    let marked = after[digits..] == format!("; last line: {}", super::write::END_MARK);
+    Some((n, marked))
+}
+
 /// True when the line holds no data (blank or comment).
 #[inline]
 fn is_blank_or_comment(line: &[u8]) -> bool {
@@ -1179,6 +1195,10 @@ fn read_impl<R: Read>(
     let mut notes: Vec<String> = Vec::new();
     // Line and text of a last record kept although it had no line end.
     let mut unterminated_last: Option<(usize, Vec<u8>)> = None;
+    // Rows the header of a file written by driftless states (`write::write_csv`), and
+    // whether it ends with the end mark; whether the input read so far does.
+    let mut declared: Option<(usize, bool)> = None;
+    let mut ends_marked = false;
     loop {
         while filled < buf.len() && !eof {
             match reader.read(&mut buf[filled..]) {
@@ -1203,6 +1223,13 @@ fn read_impl<R: Read>(
         };
         let region = &buf[..end];
         let mut start = 0;
+        if line_base == 1 && plan.is_none() {
+            declared = declared.or_else(|| declared_rows(region));
+        }
+        let tail = region.trim_ascii_end();
+        if !tail.is_empty() {
+            ends_marked = tail.ends_with(super::write::END_MARK.as_bytes());
+        }
         if plan.is_none() {
             let mut offset = 0;
             let mut sample = Vec::new();
@@ -1401,6 +1428,20 @@ fn read_impl<R: Read>(
             c.pop();
         }
         rows_total -= 1;
+    }
+    if let Some((expected, marked)) = declared
+        && (expected != rows_total || (marked && !ends_marked))
+    {
+        return Err(LogError::RowCountMismatch {
+            at: Location::input(source),
+            expected,
+            found: rows_total,
+            end_mark: if marked && !ends_marked {
+                "its last line is missing"
+            } else {
+                "its last line is there"
+            },
+        });
     }
     for c in &mut out {
         c.shrink_to_fit();
@@ -1710,5 +1751,70 @@ mod tests {
         assert_eq!(m.line_of(4), 7);
         assert_eq!(m.line_of(5), 10);
         assert_eq!(m.line_of(9), 14);
+    }
+}
+
+#[cfg(test)]
+mod row_count_tests {
+    use super::*;
+
+    fn opts() -> TextOptions {
+        TextOptions {
+            time_column: Some(ColumnRef::Name("time".into())),
+            ..TextOptions::default()
+        }
+    }
+
+    #[test]
+    fn a_driftless_csv_cut_at_a_line_end_is_an_error() {
+        let rows: String = (0..50)
+            .map(|i| format!("{},{}\n", i as f64 * 0.01, i))
+            .collect();
+        let whole = format!(
+            "# driftless log; source: test\n# tau0_s: 0.01; rows: 50; last line: # end of driftless log\n\
+             time [s],gyro_x [rad/s]\n{rows}# end of driftless log\n"
+        );
+        assert_eq!(
+            read_text_bytes(whole.as_bytes(), "w.csv", &opts())
+                .unwrap()
+                .len(),
+            50
+        );
+        let cut: String = whole.lines().take(40).map(|l| format!("{l}\n")).collect();
+        let e = read_text_bytes(cut.as_bytes(), "w.csv", &opts()).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            matches!(
+                e,
+                LogError::RowCountMismatch {
+                    expected: 50,
+                    found: 37,
+                    ..
+                }
+            ) && msg.contains("w.csv"),
+            "{msg}"
+        );
+        // All rows there, the end mark cut off.
+        let unmarked = whole.strip_suffix("# end of driftless log\n").unwrap();
+        let msg = read_text_bytes(unmarked.as_bytes(), "w.csv", &opts())
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("50 found, its last line is missing"), "{msg}");
+        // A file of an earlier writer: rows counted, no end mark expected.
+        let older = unmarked.replace("; last line: # end of driftless log", "");
+        assert_eq!(
+            read_text_bytes(older.as_bytes(), "w.csv", &opts())
+                .unwrap()
+                .len(),
+            50
+        );
+        // Without the driftless header the rows present are read.
+        let other = cut.replacen("# driftless log", "# some log", 1);
+        assert_eq!(
+            read_text_bytes(other.as_bytes(), "o.csv", &opts())
+                .unwrap()
+                .len(),
+            37
+        );
     }
 }

@@ -2,7 +2,9 @@
 //!
 //! Output: `#` comment lines with the source, τ0 and row count, then a header naming each
 //! column with its SI unit in brackets (`time [s]`, `gyro_x [rad/s]`, `temp [degC]`; no
-//! bracket for unitless channels), then one row per sample in SI. Numbers use Rust's
+//! bracket for unitless channels), then one row per sample in SI, then the comment
+//! `# end of driftless log`. The reader checks the row count and that last line, so a file
+//! cut at a line end (an interrupted write) is an error, not a shorter log. Numbers use Rust's
 //! shortest round-trip formatting, so [`super::read_text`] reads the file back bit for bit
 //! (the header units are picked up automatically; pass `time_column = Name("time")`).
 
@@ -16,14 +18,22 @@ use super::log::ImuLog;
 
 /// Writes `log` as CSV to a file.
 pub fn write_csv_file(log: &ImuLog, path: impl AsRef<Path>) -> Result<(), LogError> {
-    let (file, name) = super::error::create_file(path.as_ref())?;
-    write_impl(log, file, &name)
+    let (mut file, name) = super::error::create_file(path.as_ref())?;
+    write_impl(log, &mut file, &name)?;
+    super::error::commit_file(file, &name)
 }
 
 /// Writes `log` as CSV to any writer (errors name the output `<output>`).
 pub fn write_csv<W: Write>(log: &ImuLog, writer: W) -> Result<(), LogError> {
     write_impl(log, writer, "<output>")
 }
+
+/// How a CSV written by driftless starts. Its second line states `rows: N` and the last
+/// line, [`END_MARK`]; the reader checks both, so a file cut at a line end is an error and
+/// not a shorter log.
+pub(crate) const HEADER_MARK: &str = "# driftless log";
+/// The last line of a CSV written by driftless.
+pub(crate) const END_MARK: &str = "# end of driftless log";
 
 fn push_number(s: &mut String, v: f64) {
     let a = v.abs();
@@ -55,8 +65,13 @@ fn write_impl<W: Write>(log: &ImuLog, w: W, dest: &str) -> Result<(), LogError> 
     let mut w = std::io::BufWriter::with_capacity(1 << 20, w);
     let clean = |s: &str| s.replace(['\n', '\r'], " ");
     let mut head = String::new();
-    let _ = writeln!(head, "# driftless log; source: {}", clean(&log.source));
-    let _ = writeln!(head, "# tau0_s: {}; rows: {}", log.tau0_s, log.len());
+    let _ = writeln!(head, "{HEADER_MARK}; source: {}", clean(&log.source));
+    let _ = writeln!(
+        head,
+        "# tau0_s: {}; rows: {}; last line: {END_MARK}",
+        log.tau0_s,
+        log.len()
+    );
     let mut cols: Vec<String> = Vec::new();
     if log.time_s.is_some() {
         cols.push("time [s]".into());
@@ -91,5 +106,6 @@ fn write_impl<W: Write>(log: &ImuLog, w: W, dest: &str) -> Result<(), LogError> 
         line.push('\n');
         w.write_all(line.as_bytes()).map_err(io)?;
     }
+    writeln!(w, "{END_MARK}").map_err(io)?;
     w.flush().map_err(io)
 }

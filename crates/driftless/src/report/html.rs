@@ -250,7 +250,7 @@ fn svg_size(svg: &str) -> (String, String) {
 
 /// Writes the rendered report to `path`.
 pub fn write_html(path: impl AsRef<Path>, report: &HtmlReport) -> std::io::Result<()> {
-    std::fs::write(path, report.render())
+    crate::io::output::write(path, report.render())
 }
 
 const STYLE: &str = "

@@ -238,6 +238,7 @@ impl ThermalModelFile {
             path: name.clone(),
             message: e.to_string(),
         })?;
-        std::fs::write(path, text).map_err(|source| ThermalModelError::Io { path: name, source })
+        crate::io::output::write(path, text)
+            .map_err(|source| ThermalModelError::Io { path: name, source })
     }
 }

@@ -44,6 +44,7 @@ use super::{
 use crate::io::edge::{
     Edge, REFERENCE_SAMPLE, cut_record, last_data_line, line_of_offset, note, reference_count,
 };
+use crate::io::output::AtomicFile;
 use crate::io::{Location, LogError};
 
 /// Field separators of KF-GINS's text loader.
@@ -1305,12 +1306,29 @@ pub fn kfgins_heading_rad(yaw_rad: f64) -> f64 {
     }
 }
 
-/// Creates (truncates) one output file with a 64 KiB buffer: [`write_rows`] hands it
-/// whole chunks, which a buffer smaller than them passes straight to the file.
-fn create_output(p: &Path) -> Result<std::io::BufWriter<std::fs::File>, LogError> {
-    std::fs::File::create(p)
-        .map(|f| std::io::BufWriter::with_capacity(1 << 16, f))
-        .map_err(|e| io_error(&p.display().to_string(), e))
+/// Writes one output file atomically ([`AtomicFile`]) through a 64 KiB buffer:
+/// [`write_rows`] hands it whole chunks, which a buffer smaller than them passes straight
+/// to the file.
+fn write_output(
+    p: &Path,
+    body: impl FnOnce(std::io::BufWriter<&mut AtomicFile>, &str) -> Result<(), LogError>,
+) -> Result<(), LogError> {
+    let name = p.display().to_string();
+    let mut file = AtomicFile::create(p).map_err(|e| io_error(&name, e))?;
+    body(std::io::BufWriter::with_capacity(1 << 16, &mut file), &name)?;
+    file.commit().map_err(|e| io_error(&name, e))
+}
+
+/// Commits the three files of one run concurrently (each sync waits for its own data to
+/// reach the disk).
+fn commit_outputs(files: [AtomicFile; 3], names: &[String; 3]) -> Result<(), LogError> {
+    let [a, b, c] = files;
+    let commit = |f: AtomicFile, name: &str| f.commit().map_err(|e| io_error(name, e));
+    let ((ra, rb), rc) = rayon::join(
+        || rayon::join(|| commit(a, &names[0]), || commit(b, &names[1])),
+        || commit(c, &names[2]),
+    );
+    ra.and(rb).and(rc)
 }
 
 /// KF-GINS's three output files, written row by row or block by block — e.g. on one
@@ -1318,7 +1336,7 @@ fn create_output(p: &Path) -> Result<std::io::BufWriter<std::fs::File>, LogError
 /// ([`crate::nav::filter::run_forward_observed`]). Each file has its own [`LineBuf`],
 /// written to the file in chunks of [`CHUNK`] bytes.
 pub struct KfGinsOutputWriter {
-    files: [std::fs::File; 3],
+    files: [AtomicFile; 3],
     bufs: [Box<LineBuf>; 3],
     paths: [PathBuf; 3],
     names: [String; 3],
@@ -1327,8 +1345,9 @@ pub struct KfGinsOutputWriter {
 }
 
 impl KfGinsOutputWriter {
-    /// Creates (truncates) the three files in `dir` (KF-GINS's `outputpath`, which must
-    /// exist, as in KF-GINS).
+    /// Starts the three files in `dir` (KF-GINS's `outputpath`, which must exist, as in
+    /// KF-GINS). They replace earlier files of those names only in
+    /// [`KfGinsOutputWriter::finish`]; dropped before, the earlier files stay.
     pub fn create(dir: impl AsRef<Path>, gps_week: u16) -> Result<Self, LogError> {
         Self::create_with_suffix(dir, gps_week, "")
     }
@@ -1341,16 +1360,12 @@ impl KfGinsOutputWriter {
         suffix: &str,
     ) -> Result<Self, LogError> {
         let paths = output_file_names(suffix).map(|f| dir.as_ref().join(f));
-        // Truncated, that handle closed, and reopened for writing: ext4 (`auto_da_alloc`)
-        // allocates and starts writing back a file truncated to zero when that handle is
-        // closed — for an hour of rows 0.2–0.3 s on this thread at the end of the run
-        // (the data then reaches the disk by the kernel's normal writeback, as a newly
-        // created file's does).
+        // Each file is new (a temporary name beside the final one), so ext4's flush of a
+        // file truncated to zero when its handle closes (`auto_da_alloc`) does not apply;
+        // the data is synced once, all three files at once, in `finish`.
         let create = |p: &Path| {
-            let reopen = |()| std::fs::OpenOptions::new().write(true).open(p);
-            std::fs::File::create(p)
-                .map(drop)
-                .and_then(reopen)
+            AtomicFile::create(p)
+                .map(|f| f.durable(false))
                 .map_err(|e| io_error(&p.display().to_string(), e))
         };
         Ok(KfGinsOutputWriter {
@@ -1413,11 +1428,13 @@ impl KfGinsOutputWriter {
         Ok(())
     }
 
-    /// Writes the rest of the rows and returns the paths: `.nav`, IMU error, std.
+    /// Writes the rest of the rows, puts the three files under their final names and
+    /// returns the paths: `.nav`, IMU error, std.
     pub fn finish(mut self) -> Result<[PathBuf; 3], LogError> {
         for k in 0..3 {
             self.bufs[k].drain_to(&mut self.files[k], &self.names[k])?;
         }
+        commit_outputs(self.files, &self.names)?;
         Ok(self.paths)
     }
 }
@@ -1432,17 +1449,15 @@ pub fn write_kfgins_outputs(
     gps_week: u16,
 ) -> Result<[PathBuf; 3], LogError> {
     let paths = output_paths(dir.as_ref());
-    let create = create_output;
-    let name = |p: &Path| p.display().to_string();
     // The three files are independent and formatting-bound: write them concurrently.
     let ((nav, err), std_res) = rayon::join(
         || {
             rayon::join(
-                || write_kfgins_nav(create(&paths[0])?, &name(&paths[0]), sol, gps_week),
-                || write_kfgins_imu_err(create(&paths[1])?, &name(&paths[1]), imu_err),
+                || write_output(&paths[0], |w, n| write_kfgins_nav(w, n, sol, gps_week)),
+                || write_output(&paths[1], |w, n| write_kfgins_imu_err(w, n, imu_err)),
             )
         },
-        || write_kfgins_std(create(&paths[2])?, &name(&paths[2]), std),
+        || write_output(&paths[2], |w, n| write_kfgins_std(w, n, std)),
     );
     nav?;
     err?;

@@ -16,8 +16,8 @@ fn io_err(path: &Path) -> impl Fn(std::io::Error) -> LogError + '_ {
 
 /// Write the solution as CSV with a header naming each column and unit.
 pub fn write_solution_csv(path: &Path, sol: &NavSolution) -> Result<(), LogError> {
-    let (file, _) = crate::io::error::create_file(path)?;
-    let mut w = std::io::BufWriter::with_capacity(1 << 20, file);
+    let (mut file, name) = crate::io::error::create_file(path)?;
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, &mut file);
     let e = io_err(path);
     writeln!(
         w,
@@ -43,14 +43,16 @@ pub fn write_solution_csv(path: &Path, sol: &NavSolution) -> Result<(), LogError
         )
         .map_err(&e)?;
     }
-    w.flush().map_err(&e)
+    w.flush().map_err(&e)?;
+    drop(w);
+    crate::io::error::commit_file(file, &name)
 }
 
 /// Write the track as a GeoJSON `FeatureCollection` with one `LineString`, keeping every
 /// `stride`-th epoch (and the last) so a 200 Hz solution stays light for map viewers.
 pub fn write_track_geojson(path: &Path, sol: &NavSolution, stride: usize) -> Result<(), LogError> {
-    let (file, _) = crate::io::error::create_file(path)?;
-    let mut w = std::io::BufWriter::new(file);
+    let (mut file, name) = crate::io::error::create_file(path)?;
+    let mut w = std::io::BufWriter::new(&mut file);
     let e = io_err(path);
     let n = sol.time_s.len();
     let stride = stride.max(1);
@@ -77,7 +79,9 @@ pub fn write_track_geojson(path: &Path, sol: &NavSolution, stride: usize) -> Res
         .map_err(&e)?;
     }
     w.write_all(b"]}}]}\n").map_err(&e)?;
-    w.flush().map_err(&e)
+    w.flush().map_err(&e)?;
+    drop(w);
+    crate::io::error::commit_file(file, &name)
 }
 
 #[cfg(test)]

@@ -144,7 +144,7 @@ pub fn render_png_bytes(fig: &Figure, scale: f64) -> Result<Vec<u8>, PlotError> 
 pub fn render_png(fig: &Figure, path: impl AsRef<Path>) -> Result<(), PlotError> {
     let bytes = render_png_bytes(fig, DEFAULT_PNG_SCALE)?;
     let path = path.as_ref();
-    std::fs::write(path, bytes).map_err(|source| PlotError::Io {
+    crate::io::output::write(path, bytes).map_err(|source| PlotError::Io {
         path: path.to_path_buf(),
         source,
     })
@@ -156,7 +156,7 @@ pub fn render_png(fig: &Figure, path: impl AsRef<Path>) -> Result<(), PlotError>
 /// [`PlotError::Io`] if the file cannot be written.
 pub fn write_svg(fig: &Figure, path: impl AsRef<Path>) -> Result<(), PlotError> {
     let path = path.as_ref();
-    std::fs::write(path, render_svg(fig)).map_err(|source| PlotError::Io {
+    crate::io::output::write(path, render_svg(fig)).map_err(|source| PlotError::Io {
         path: path.to_path_buf(),
         source,
     })
