@@ -10,17 +10,24 @@ use std::path::PathBuf;
 pub struct ConvertArgs {
     /// Input log (text, binary DRIFTLOG, PX4 ULog or ArduPilot DataFlash).
     pub input: PathBuf,
-    /// Output: `.dlog` (binary DRIFTLOG) or `.csv` / `.txt` (delimited text).
-    #[arg(value_parser = log_output_path)]
+    /// Output: `.dlog` (binary DRIFTLOG) or `.csv` / `.txt` (delimited text); another
+    /// name (a device, a pipe) needs `--to`.
     pub output: PathBuf,
+    /// Output format, instead of the name's ending.
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub to: Option<LogFormat>,
     #[command(flatten)]
     pub read: InputArgs,
 }
 
-/// The output formats by file-name ending.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum LogFormat {
+/// The output formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum LogFormat {
+    /// Delimited text (CSV).
+    #[value(name = "csv")]
     Text,
+    /// Binary DRIFTLOG.
+    #[value(name = "dlog")]
     Binary,
 }
 
@@ -33,20 +40,14 @@ fn log_format(p: &std::path::Path) -> Option<LogFormat> {
     }
 }
 
-/// Output value parser: the name says the format, checked before the input is read.
-fn log_output_path(s: &str) -> Result<PathBuf, String> {
-    let p = PathBuf::from(s);
-    match log_format(&p) {
-        Some(_) => Ok(p),
-        None => Err(format!(
-            "{s}: the output format follows the name's ending: .dlog (binary DRIFTLOG) or \
-             .csv / .txt (delimited text)"
-        )),
-    }
-}
-
 pub fn run(a: ConvertArgs) -> Result<()> {
-    let format = log_format(&a.output).context("output name ends in neither .dlog nor .csv")?;
+    let Some(format) = a.to.or_else(|| log_format(&a.output)) else {
+        anyhow::bail!(
+            "{}: the output format follows the name's ending, .dlog (binary DRIFTLOG) or \
+             .csv / .txt (delimited text); for another name give --to csv|dlog",
+            a.output.display()
+        );
+    };
     crate::paths::refuse_outputs_over_inputs(&[Some(&a.output)], &[Some(&a.input)])?;
     let log = crate::allan_cmd::read_with_progress(&a.read, &a.input, false)?;
     match format {

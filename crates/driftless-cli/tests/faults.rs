@@ -114,6 +114,7 @@ fn a_failed_write_keeps_the_earlier_file() {
     // A device that is full: a clear error, exit 1.
     let o = bin()
         .arg("convert")
+        .args(["--to", "csv"])
         .arg(&input)
         .arg("/dev/full")
         .output()
@@ -217,11 +218,15 @@ fn a_kill_mid_write_leaves_old_or_complete_files() {
     let mut saw_partial_run = false;
     for trial in 0..12 {
         let run = d.join(format!("run{trial}"));
+        // The kill falls inside the run: a random instant within the time this machine
+        // takes for one whole run (measured on the run that lays the old files).
+        let clock = std::time::Instant::now();
         simulate(&run, 1);
+        let whole_ms = (clock.elapsed().as_millis() as u64).max(10);
         state = state
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
-        let delay_ms = 20 + (state >> 33) % 250;
+        let delay_ms = whole_ms / 20 + (state >> 33) % (whole_ms * 9 / 10);
         let mut child = bin()
             .args(["simulate", "--json", "--force", "--seed", "2", "--out"])
             .arg(&run)

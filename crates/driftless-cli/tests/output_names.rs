@@ -77,8 +77,11 @@ fn convert_refuses_an_output_format_it_does_not_write() {
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("out.xlsx") && err.contains(".dlog"), "{err}");
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("out.xlsx") && err.contains(".dlog") && err.contains("--to csv|dlog"),
+        "{err}"
+    );
     assert!(!d.join("out.xlsx").exists());
     for name in ["out.dlog", "out.csv"] {
         let out = bin()
