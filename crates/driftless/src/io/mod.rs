@@ -9,8 +9,6 @@
 //! * [`units`]: unit strings → SI conversion.
 //! * [`error`]: one error type, [`LogError`], naming file, line and column.
 //! * [`output`]: every output file, written atomically; checks of output paths against inputs.
-//!
-//! OWNER: helper "io" (text, binary, units, errors, fuzzing).
 
 #[cfg(feature = "autopilot-logs")]
 pub mod autopilot;

@@ -14,8 +14,6 @@
 //! * [`rtklib`]: RTKLIB `.pos` solutions and binary `.tag` time-tag files, and the mapping of
 //!   a tick-stamped IMU CSV to GPS time.
 //! * [`gpstime`]: GPS time (GPST, no leap seconds) ↔ calendar and (week, seconds of week).
-//!
-//! OWNER: helper "navio".
 
 pub mod gpstime;
 pub mod kfgins;
