@@ -1464,7 +1464,8 @@ mod tests {
         assert!(!short_tau_coloured(&[], 1_000_000));
         let m: Vec<usize> = (1..=400).collect();
         let c = auto_range_candidates(&m);
-        assert_eq!(&c[..5], &[0, 1, 2, 3, 5]);
+        let cm: Vec<usize> = c.iter().map(|&i| m[i]).collect();
+        assert_eq!(&cm[..5], &[1, 2, 3, 5, 8]);
         assert!(c.iter().all(|&i| m[i] <= AUTO_RANGE_MAX_M));
         assert!(c.windows(2).all(|w| 2 * m[w[1]] >= 3 * m[w[0]]));
     }
@@ -1511,9 +1512,10 @@ mod tests {
             .find(|u| u.term == TermKind::GaussMarkov)
             .expect("reported");
         assert!(ni.reason.contains("bound"), "{ni:?}");
-        // The white noise takes the term's power: N² + 2σ²T.
+        // The white noise takes the term's power, N² + 2σ²T at τ ≫ T (a little less at
+        // the shortest τ, where τ/T is only 3).
         let want = (n * n + 2.0 * s * s * t).sqrt();
-        assert!((f.white.unwrap().value / want - 1.0).abs() < 0.01, "{f:?}");
+        assert!((f.white.unwrap().value / want - 1.0).abs() < 0.05, "{f:?}");
         // A correlation time inside the bounds is still found.
         let avar2: Vec<f64> = tau
             .iter()

@@ -1069,7 +1069,7 @@ mod tests {
         assert!(fit.quantization.is_none());
         let q = &fit.not_identifiable[0];
         assert_eq!(q.term, TermKind::Quantization);
-        assert!(q.reason.contains("3.4x"), "{q:?}");
+        assert!(q.reason.contains("3.5x"), "{q:?}");
         // A quantization the step explains stays; no step known: no check.
         let mut ok = gyro_fit();
         ok.quantization = Some(Term {
@@ -1116,12 +1116,21 @@ mod tests {
         };
         assert!(bias_floor_tau(&fit).is_none());
         assert!(discrete_noise(&fit, 100.0).bias_instability_gm.is_none());
+        // With K the floor is at √3·N/K ≈ 1 870 s: inside a range to 10⁴ s.
         let with_k = NoiseFit {
             gauss_markov: None,
-            fit_range: fit.fit_range,
+            fit_range: fit.fit_range.map(|r| FitRange {
+                tau_max_s: 1e4,
+                ..r
+            }),
             ..gyro_fit()
         };
         assert!(discrete_noise(&with_k, 100.0).bias_instability_gm.is_some());
+        let short = NoiseFit {
+            fit_range: fit.fit_range,
+            ..with_k.clone()
+        };
+        assert!(discrete_noise(&short, 100.0).bias_instability_gm.is_none());
     }
 
     #[test]
