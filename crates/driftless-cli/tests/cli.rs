@@ -525,10 +525,8 @@ fn allan_fit_range_automatic_and_by_hand() {
     assert!(r["tau_min_s"].as_f64().unwrap() >= 0.5 && r["tau_max_s"].as_f64().unwrap() <= 50.0);
 
     for bad in ["5:1", "abc", "0.1", "-1:5"] {
-        expect_error(
-            &["allan", path, "--fit-range", bad],
-            &["--fit-range", "TMIN:TMAX"],
-        );
+        let flag = format!("--fit-range={bad}");
+        expect_error(&["allan", path, &flag], &["--fit-range", "TMIN:TMAX"]);
     }
     expect_error(
         &["allan", path, "--fit-range", "1e6:2e6"],

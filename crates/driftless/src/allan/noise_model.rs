@@ -461,23 +461,27 @@ fn user_indices(c: &ChannelResult, r: FitRangeSpec) -> Result<(usize, usize), Al
 }
 
 /// The automatic fit range: the fit from each candidate first point (shortest first)
-/// to the curve's end; the first whose χ²_red is at most [`CHI2_RED_GOOD`] — the widest
-/// range over which the model follows the curve within its uncertainty — or, if none
-/// is, the candidate with the smallest χ²_red.
-fn auto_range<F>(
+/// to the curve's end; the first whose χ²_red is at most [`CHI2_RED_GOOD`] over the whole
+/// range *and* over its first half decade (`head(i0, fit)`: where a filter's leftover
+/// shows, and where the whole-range χ²_red would dilute it) — the widest range over which
+/// the model follows the curve within its uncertainty — or, if none is, the candidate
+/// with the smallest χ²_red.
+fn auto_range<F, H>(
     candidates: &[usize],
     n: usize,
     fit_over: &F,
+    head: &H,
 ) -> Result<(usize, usize, RangeSource, NoiseFit), AllanError>
 where
     F: Fn(usize, usize) -> Result<NoiseFit, AllanError>,
+    H: Fn(usize, &NoiseFit) -> f64,
 {
     let mut best: Option<(usize, NoiseFit)> = None;
     let mut first_err = None;
     for &i0 in candidates {
         match fit_over(i0, n) {
             Ok(f) => {
-                let good = f.chi2_reduced <= CHI2_RED_GOOD;
+                let good = f.chi2_reduced <= CHI2_RED_GOOD && head(i0, &f) <= CHI2_RED_GOOD;
                 if best
                     .as_ref()
                     .is_none_or(|(_, b)| f.chi2_reduced < b.chi2_reduced)
@@ -720,7 +724,23 @@ impl NoiseModel {
                         .map_or(0, |n| n.saturating_sub(1));
                     if short_tau_coloured(&c.rate_acf1, longest) {
                         let m: Vec<usize> = c.points.iter().map(|p| p.m).collect();
-                        auto_range(&auto_range_candidates(&m), n, &fit_over)
+                        // Mean squared normalised residual over the first half decade
+                        // of the range, with the fit's own weights.
+                        let head = |i0: usize, f: &NoiseFit| -> f64 {
+                            let (mut sum, mut k) = (0.0, 0usize);
+                            for i in (i0..n).take_while(|&i| tau[i] <= 3.0 * tau[i0]) {
+                                let model = f.model_avar(tau[i]);
+                                let nu = c.edf_for_alpha(i, f.dominant_alpha(tau[i]));
+                                if model > 0.0 && nu > 0.0 {
+                                    let var =
+                                        model * model * (2.0 / nu + opts.model_error_floor.powi(2));
+                                    sum += (avar[i] - model).powi(2) / var;
+                                    k += 1;
+                                }
+                            }
+                            if k == 0 { 0.0 } else { sum / k as f64 }
+                        };
+                        auto_range(&auto_range_candidates(&m), n, &fit_over, &head)
                             .map_err(|e| named(e, false))?
                     } else {
                         let f = fit_over(0, n).map_err(|e| named(e, false))?;
@@ -1094,7 +1114,7 @@ mod tests {
             }),
             ..gyro_fit()
         });
-        assert!(text.contains("fit range 0.2000 … 2500.0 s"), "{text}");
+        assert!(text.contains("fit range 0.20000 … 2500.0 s"), "{text}");
         assert!(text.contains("14 short-tau point(s) left out"), "{text}");
         assert!(text.contains("WARNING: poor"), "{text}");
     }
