@@ -5,10 +5,10 @@ use crate::output::{Table, sci};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use driftless::allan::analysis::{AnalysisConfig, ChannelResult, analyse_channels};
-use driftless::allan::fit::FitConfig;
+use driftless::allan::fit::{FitConfig, FitRangeSpec, chi2_verdict};
 use driftless::allan::gmwm::{self, GmwmChannel, GmwmConfig};
 use driftless::allan::lines::{self, ChannelLines, LineConfig, SpectralLine};
-use driftless::allan::noise_model::NoiseModel;
+use driftless::allan::noise_model::{ModelOptions, NoiseModel};
 use driftless::allan::taus::TauSpec;
 use driftless::allan::{DataType, Estimator};
 use driftless::allan::{checks, plausibility};
@@ -73,6 +73,11 @@ pub struct AllanArgs {
     /// q, n, k, r, gm (up to three Gauss-Markov terms) or gm1..gm4; default q,n,k,r,gm.
     #[arg(long, value_name = "LIST")]
     pub terms: Option<String>,
+    /// Fit the Allan noise terms over TMIN:TMAX seconds only (either side may be empty:
+    /// the curve's end). By default the short taus where the sensor's own filtering
+    /// colours the noise (averaged rates still correlated) are left out automatically.
+    #[arg(long, value_name = "TMIN:TMAX")]
+    pub fit_range: Option<String>,
     /// Skip the noise-term fit.
     #[arg(long)]
     pub no_fit: bool,
@@ -133,8 +138,8 @@ pub fn analysis_config(a: &AllanArgs) -> Result<AnalysisConfig> {
 /// Which noise model to fit.
 #[derive(Clone, Debug)]
 pub enum NoiseMethod {
-    /// IEEE 952 term fit to the OADEV curve.
-    Allan(FitConfig),
+    /// IEEE 952 term fit to the OADEV curve, over a user range (None: automatic).
+    Allan(FitConfig, Option<FitRangeSpec>),
     /// GMWM.
     Gmwm(GmwmConfig),
 }
@@ -151,7 +156,7 @@ pub fn analyse_log(
     analyse_log_with(
         log,
         cfg,
-        fit.cloned().map(NoiseMethod::Allan).as_ref(),
+        fit.cloned().map(|f| NoiseMethod::Allan(f, None)).as_ref(),
         scale,
         remove_lines,
     )
@@ -261,7 +266,7 @@ pub fn analyse_log_with(
             ..cfg.clone()
         }
     };
-    let needs_curves = matches!(method, Some(NoiseMethod::Allan(_))) || !with_lines.is_empty();
+    let needs_curves = matches!(method, Some(NoiseMethod::Allan(..))) || !with_lines.is_empty();
     let base_curves;
     let base: &[ChannelResult] = if cfg.estimator == Estimator::Oadev {
         &results
@@ -301,13 +306,33 @@ pub fn analyse_log_with(
                 .with_context(|| format!("GMWM of {}", log.source))?;
             Some(gmwm::noise_model(&log.source, &gmwm_channels, &quantities)?)
         }
-        Some(NoiseMethod::Allan(fc)) => Some(NoiseModel::from_curves(
-            &log.source,
-            &fit_curves,
-            &quantities,
-            fc,
-            cfg.confidence,
-        )?),
+        Some(NoiseMethod::Allan(fc, range)) => {
+            let resolution = match cfg.data_type {
+                DataType::Frequency => data
+                    .par_iter()
+                    .map(|d| checks::resolution_step(d))
+                    .collect(),
+                DataType::Phase => Vec::new(),
+            };
+            let opts = ModelOptions {
+                fit_range: *range,
+                resolution,
+                ..ModelOptions::default()
+            };
+            let model = NoiseModel::from_curves_with(
+                &log.source,
+                &fit_curves,
+                &quantities,
+                fc,
+                cfg.confidence,
+                &opts,
+            );
+            Some(if range.is_some() {
+                model.context("--fit-range")?
+            } else {
+                model?
+            })
+        }
     };
     let mut warnings = Vec::new();
     for (&i, d) in keep.iter().zip(&data) {
@@ -341,6 +366,19 @@ pub fn analyse_log_with(
             .position(|&i| log.channels[i].name == l.channel)
             .map_or("", |k| units[k].as_str());
         warnings.push(l.describe(unit));
+    }
+    if let Some(model) = &noise
+        && gmwm_channels.is_empty()
+    {
+        for c in &model.channels {
+            let (verdict, warn) = chi2_verdict(c.fit.chi2_reduced);
+            if warn {
+                warnings.push(format!(
+                    "{}: noise fit chi2_red = {:.3} — {verdict}",
+                    c.name, c.fit.chi2_reduced
+                ));
+            }
+        }
     }
     if let Some(model) = &noise {
         let record_s = log.len() as f64 * log.tau0_s;
@@ -443,8 +481,16 @@ pub fn noise_method(a: &AllanArgs) -> Result<NoiseMethod> {
                 .unwrap_or("q,n,b,k,r")
                 .parse::<FitConfig>()
                 .context("--terms")?,
+            a.fit_range
+                .as_deref()
+                .map(str::parse::<FitRangeSpec>)
+                .transpose()
+                .context("--fit-range")?,
         ),
         MethodArg::Gmwm => {
+            if a.fit_range.is_some() {
+                bail!("--fit-range applies to the Allan fit; drop it with --method gmwm");
+            }
             let terms = match &a.terms {
                 Some(t) => t
                     .parse::<GmwmConfig>()
@@ -491,13 +537,27 @@ pub fn json_output(out: &AllanOutput) -> serde_json::Value {
                 "dev_hi": r.dev_hi,
                 "alpha": r.alpha,
                 "edf": r.edf,
+                "rate_acf1": r.rate_acf1,
             })
         })
         .collect();
-    let noise = match &out.noise {
+    let mut noise = match &out.noise {
         Some(m) => serde_json::to_value(m).unwrap_or(serde_json::Value::Null),
         None => serde_json::Value::Null,
     };
+    if let (Some(m), true) = (&out.noise, out.gmwm.is_empty())
+        && let Some(chs) = noise
+            .get_mut("channels")
+            .and_then(serde_json::Value::as_array_mut)
+    {
+        for (j, c) in chs.iter_mut().zip(&m.channels) {
+            let (verdict, warn) = chi2_verdict(c.fit.chi2_reduced);
+            if let Some(fit) = j.get_mut("fit").and_then(serde_json::Value::as_object_mut) {
+                fit.insert("chi2_verdict".into(), verdict.into());
+                fit.insert("chi2_warning".into(), warn.into());
+            }
+        }
+    }
     let mut doc = serde_json::json!({
         "channels": channels,
         "noise": noise,

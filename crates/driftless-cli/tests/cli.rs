@@ -470,3 +470,70 @@ fn allan_warns_on_the_real_drive_log() {
             .any(|w| w.as_str().unwrap().contains("not static"))
     );
 }
+
+/// White noise through a 4-tap moving average (a sensor's anti-alias filter): the fit
+/// leaves out the short τ it colours and says so; `--fit-range` sets the range by hand;
+/// bad ranges are one error naming the flag.
+#[test]
+fn allan_fit_range_automatic_and_by_hand() {
+    let white = |i: usize| {
+        let mut z = (i as u64 + 17).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 31)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z ^= z >> 29;
+        ((z >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.02
+    };
+    let mut s = String::from("time,gyro_z\n");
+    for i in 0..100_000 {
+        let w = (0..4).map(|k| white(i + k)).sum::<f64>() / 4.0;
+        s.push_str(&format!("{:.2},{w:.9}\n", i as f64 * 0.01));
+    }
+    let path = tmp_file("allan-filtered.csv", &s);
+    let path = path.to_str().unwrap();
+    let out = run(&["allan", path, "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let fit = &v["noise"]["channels"][0]["fit"];
+    assert_eq!(fit["fit_range"]["source"], "auto", "{fit}");
+    assert!(
+        fit["fit_range"]["excluded_short"].as_u64().unwrap() >= 1,
+        "{fit}"
+    );
+    assert!(fit["fit_range"]["tau_min_s"].as_f64().unwrap() > 0.01);
+    assert!(fit["chi2_reduced"].as_f64().unwrap() <= 5.0, "{fit}");
+    assert!(fit["chi2_verdict"].as_str().unwrap().len() > 4);
+    assert!(v["channels"][0]["rate_acf1"][0].as_f64().unwrap() > 0.5);
+
+    let text = run(&["allan", path]);
+    let stdout = String::from_utf8_lossy(&text.stdout);
+    assert!(stdout.contains("fit range 0."), "{stdout}");
+    assert!(stdout.contains("automatic:"), "{stdout}");
+    assert!(stdout.contains("chi2_red"), "{stdout}");
+
+    let out = run(&["allan", path, "--json", "--fit-range", "0.5:50"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = &v["noise"]["channels"][0]["fit"]["fit_range"];
+    assert_eq!(r["source"], "user");
+    assert!(r["tau_min_s"].as_f64().unwrap() >= 0.5 && r["tau_max_s"].as_f64().unwrap() <= 50.0);
+
+    for bad in ["5:1", "abc", "0.1", "-1:5"] {
+        let flag = format!("--fit-range={bad}");
+        expect_error(&["allan", path, &flag], &["--fit-range", "TMIN:TMAX"]);
+    }
+    expect_error(
+        &["allan", path, "--fit-range", "1e6:2e6"],
+        &["--fit-range", "no curve point inside"],
+    );
+    expect_error(
+        &["allan", path, "--fit-range", "1:10", "--method", "gmwm"],
+        &["--fit-range", "gmwm"],
+    );
+}

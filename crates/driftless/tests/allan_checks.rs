@@ -72,6 +72,8 @@ fn fit(white: f64, bias: f64, rrw: f64) -> NoiseFit {
         not_detected: Vec::new(),
         chi2_reduced: 1.0,
         n_points: 20,
+        fit_range: None,
+        not_identifiable: Vec::new(),
     }
 }
 

@@ -266,6 +266,8 @@ fn noise_model_file_sets_the_six_axes() {
         not_detected: Vec::new(),
         chi2_reduced: 1.0,
         n_points: 100,
+        fit_range: None,
+        not_identifiable: Vec::new(),
     };
     let mut model = NoiseModel::new(Some("test".into()), FS, Some("oadev".into()));
     for (a, name) in CHANNEL_NAMES.iter().enumerate() {

@@ -70,6 +70,42 @@ pub struct ChannelResult {
     pub segment_phase_points: Vec<usize>,
     /// Whether the reduced-overlap fast estimator produced the curve.
     pub fast: bool,
+    /// Lag-1 autocorrelation of the rates averaged over τ (non-overlapping blocks of m
+    /// samples of the longest segment), per point; NaN where fewer than
+    /// [`MIN_ACF_BLOCKS`] blocks exist. ≈ 0 for white noise, negative where quantization
+    /// dominates, positive where the sensor's own filtering colours the noise (see
+    /// [`super::fit::auto_fit_start`]).
+    #[serde(default)]
+    pub rate_acf1: Vec<f64>,
+}
+
+/// Fewest averaged blocks for which [`rate_lag1_acf`] is computed.
+pub const MIN_ACF_BLOCKS: usize = 30;
+
+/// Lag-1 autocorrelation of the rates averaged over non-overlapping blocks of `m`
+/// samples, read from phase `x` (x_k = τ0·Σ y): ȳ_j = (x_{(j+1)m} − x_{jm})/(mτ0), then
+/// r₁ = Σ (ȳ_j − ȳ)(ȳ_{j+1} − ȳ) / Σ (ȳ_j − ȳ)² (Box & Jenkins 1976 §2.1.5; the statistic
+/// behind the noise identification of Riley & Greenhall 2004). NaN when fewer than
+/// [`MIN_ACF_BLOCKS`] blocks exist or the blocks are constant. The scale τ0 cancels.
+pub fn rate_lag1_acf(x: &[f64], m: usize) -> f64 {
+    if m == 0 || x.len() < 2 {
+        return f64::NAN;
+    }
+    let nb = (x.len() - 1) / m;
+    if nb < MIN_ACF_BLOCKS {
+        return f64::NAN;
+    }
+    let y: Vec<f64> = (0..nb).map(|j| x[(j + 1) * m] - x[j * m]).collect();
+    let mean = y.iter().sum::<f64>() / nb as f64;
+    let (mut c0, mut c1) = (0.0, 0.0);
+    for j in 0..nb {
+        let d = y[j] - mean;
+        c0 += d * d;
+        if j + 1 < nb {
+            c1 += d * (y[j + 1] - mean);
+        }
+    }
+    if c0 > 0.0 { c1 / c0 } else { f64::NAN }
 }
 
 impl ChannelResult {
@@ -190,6 +226,11 @@ pub fn analyse_segments(
             None => ci::identify_alpha(longest, s.m, cfg.estimator),
         })
         .collect();
+    // Lag-1 autocorrelation of the τ-averaged rates, for the automatic fit range.
+    let rate_acf1: Vec<f64> = total
+        .par_iter()
+        .map(|s| rate_lag1_acf(longest, s.m))
+        .collect();
     let mut last_alpha: Option<i32> = None;
     for (s, id) in total.into_iter().zip(identified) {
         let dev = estimators::finish(cfg.estimator, s, tau0_s);
@@ -244,6 +285,7 @@ pub fn analyse_segments(
         confidence: cfg.confidence,
         segment_phase_points: phases.iter().map(Vec::len).collect(),
         fast: cfg.fast,
+        rate_acf1,
     })
 }
 

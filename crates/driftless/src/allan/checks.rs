@@ -143,8 +143,58 @@ pub fn record_length_warnings(
     out
 }
 
+/// Samples read for [`resolution_step`].
+const RESOLUTION_SAMPLES: usize = 200_000;
+
+/// The resolution step Δ of quantized samples: the smallest gap between distinct values
+/// of (up to the first 200 000) samples, accepted when the values repeat (fewer distinct
+/// values than a tenth of the samples) and at least 95 % of the gaps between neighbouring
+/// distinct values are whole multiples of it (within 1 %). None for unquantized data.
+pub fn resolution_step(values: &[f64]) -> Option<f64> {
+    let mut v: Vec<f64> = values
+        .iter()
+        .take(RESOLUTION_SAMPLES)
+        .copied()
+        .filter(|x| x.is_finite())
+        .collect();
+    if v.len() < 100 {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    if v.len() < 2 || v.len() * 10 > values.len().min(RESOLUTION_SAMPLES) {
+        return None;
+    }
+    let gaps: Vec<f64> = v.windows(2).map(|w| w[1] - w[0]).collect();
+    let step = gaps.iter().copied().fold(f64::INFINITY, f64::min);
+    if !(step > 0.0 && step.is_finite()) {
+        return None;
+    }
+    let whole = gaps
+        .iter()
+        .filter(|&&g| {
+            let k = g / step;
+            (k - k.round()).abs() < 0.01
+        })
+        .count();
+    (whole as f64 >= 0.95 * gaps.len() as f64).then_some(step)
+}
+
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn resolution_step_of_quantized_and_continuous_samples() {
+        let step = 0.05 * std::f64::consts::PI / 180.0;
+        let q: Vec<f64> = (0..10_000)
+            .map(|i| ((i * 7919 % 13) as f64 - 6.0) * step)
+            .collect();
+        let got = resolution_step(&q).expect("quantized");
+        assert!((got / step - 1.0).abs() < 1e-9, "{got}");
+        let c: Vec<f64> = (0..10_000).map(|i| (i as f64 * 0.37).sin()).collect();
+        assert!(resolution_step(&c).is_none());
+        assert!(resolution_step(&q[..50]).is_none());
+    }
     use super::*;
 
     #[test]

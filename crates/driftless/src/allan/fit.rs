@@ -14,9 +14,12 @@
 //! The model is linear in θ = (Q², N², B², K², R²). Each Allan-variance estimate
 //! σ̂²(τ_i) is approximately a scaled χ² variable with ν_i equivalent degrees of freedom
 //! (Greenhall & Riley 2003; NIST SP 1065 §5.3), so var σ̂²_i ≈ 2σ⁴(τ_i)/ν_i. The fit
-//! minimises Σ w_i (σ̂²_i − m_i(θ))² with w_i = ν_i/(2 m_i²) where m_i is the **model**
-//! value (weighting by the data instead biases the fit low, because low estimates get
-//! large weights), subject to θ ≥ 0. The weights are updated from the model and the
+//! minimises Σ w_i (σ̂²_i − m_i(θ))² with w_i = 1/(m_i²(2/ν_i + f²)) where m_i is the
+//! **model** value (weighting by the data instead biases the fit low, because low
+//! estimates get large weights) and f a relative model-error floor
+//! ([`MODEL_ERROR_FLOOR`]: no point counts as more precise than f, so the few short-τ
+//! points with EDF of 10⁵–10⁶ cannot decide the fit alone; the floor only bites where
+//! 2/ν < f², i.e. ν > 2/f²), subject to θ ≥ 0. The weights are updated from the model and the
 //! non-negative least squares (NNLS) problem re-solved until the model stops changing
 //! (iteratively reweighted least squares). The NNLS is solved exactly by enumerating the
 //! at most 2⁶ supports (a feasible support with the smallest weighted residual is the
@@ -38,6 +41,17 @@
 //!
 //! The interval on the square θ_j ± z·s_j (z the two-sided normal quantile) is clamped at
 //! zero and square-rooted, so Q, N, B, K, R intervals are asymmetric and never negative.
+//!
+//! # Where the model applies
+//!
+//! Below a few sample intervals a real sensor's output is not white: its anti-alias
+//! filtering and decimation correlate neighbouring samples, σ²(τ) falls below N²/τ, and no
+//! IEEE 952 term describes that. [`short_tau_coloured`] tells from the lag-1
+//! autocorrelation of the samples; the noise model then chooses the first point of the fit
+//! among [`auto_range_candidates`] (see `noise_model::NoiseModel::from_curves_with`).
+//! χ²_red is read by [`chi2_verdict`]. A Gauss-Markov correlation time is searched only
+//! where the record can show it ([`FitOptions`]); a bound hit is reported in
+//! [`NoiseFit::not_identifiable`].
 //!
 //! The classic single-point "slope" readings (N at τ = 1 s on the −½ line, B = σ_min/0.664,
 //! K at τ = 3 s on the +½ line; IEEE 952 Fig. C.2) are available as a diagnostic through
@@ -264,6 +278,194 @@ pub struct NoiseFit {
     /// Number of (tau, avar) points fitted.
     #[serde(default)]
     pub n_points: usize,
+    /// The τ range the model was fitted over and how it was chosen (absent in files
+    /// written before the range was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fit_range: Option<FitRange>,
+    /// Terms the data cannot pin down (a Gauss-Markov correlation time at its search
+    /// bound, a quantization far above the resolution step, …): reported here, never
+    /// stored as values.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_identifiable: Vec<NotIdentifiable>,
+}
+
+/// How the τ range of the fit was chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RangeSource {
+    /// The whole curve.
+    Full,
+    /// Short τ left out automatically where the averaged rates are correlated
+    /// ([`auto_fit_start`]).
+    Auto,
+    /// Given by the user (`--fit-range`).
+    User,
+}
+
+/// The τ range of a fit.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FitRange {
+    /// Smallest fitted τ, s.
+    pub tau_min_s: f64,
+    /// Largest fitted τ, s.
+    pub tau_max_s: f64,
+    /// How the range was chosen.
+    pub source: RangeSource,
+    /// Curve points below the range (left out).
+    pub excluded_short: usize,
+    /// Curve points above the range (left out).
+    pub excluded_long: usize,
+}
+
+/// A term that was switched on but that the data cannot determine, with the reason.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NotIdentifiable {
+    /// Which term.
+    pub term: TermKind,
+    /// Why, in plain words.
+    pub reason: String,
+}
+
+/// χ²_red above which a fit is reported as not describing the curve.
+pub const CHI2_RED_WARN: f64 = 5.0;
+/// χ²_red up to which a fit is reported as following the curve within its uncertainty.
+pub const CHI2_RED_GOOD: f64 = 2.0;
+
+/// Plain-words reading of χ²_red and whether it deserves a warning.
+pub fn chi2_verdict(chi2_red: f64) -> (&'static str, bool) {
+    if !chi2_red.is_finite() {
+        ("no goodness of fit (too few points)", true)
+    } else if chi2_red <= CHI2_RED_GOOD {
+        (
+            "good: the model follows the curve within its uncertainty",
+            false,
+        )
+    } else if chi2_red <= CHI2_RED_WARN {
+        ("fair: small systematic departures from the curve", false)
+    } else {
+        (
+            "poor: the model does not describe the curve (check the fit range and the terms)",
+            true,
+        )
+    }
+}
+
+/// A user-given fit range `TMIN:TMAX` in seconds; an empty side means the curve's end.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FitRangeSpec {
+    /// Smallest τ to fit, s (None: from the start of the curve).
+    pub tau_min_s: Option<f64>,
+    /// Largest τ to fit, s (None: to the end of the curve).
+    pub tau_max_s: Option<f64>,
+}
+
+impl std::str::FromStr for FitRangeSpec {
+    type Err = AllanError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let bad = |why: &str| {
+            AllanError::Invalid(format!(
+                "fit range {s:?}: {why} (expected TMIN:TMAX in seconds, e.g. 0.2:2000 or 0.2:)"
+            ))
+        };
+        let (a, b) = s.split_once(':').ok_or_else(|| bad("no ':'"))?;
+        let side = |t: &str, which: &str| -> Result<Option<f64>, AllanError> {
+            let t = t.trim();
+            if t.is_empty() {
+                return Ok(None);
+            }
+            let v: f64 = t
+                .parse()
+                .map_err(|_| bad(&format!("{which} {t:?} is not a number")))?;
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(&format!(
+                    "{which} must be a positive number of seconds"
+                )));
+            }
+            Ok(Some(v))
+        };
+        let spec = FitRangeSpec {
+            tau_min_s: side(a, "TMIN")?,
+            tau_max_s: side(b, "TMAX")?,
+        };
+        if let (Some(lo), Some(hi)) = (spec.tau_min_s, spec.tau_max_s)
+            && lo >= hi
+        {
+            return Err(bad("TMIN must be below TMAX"));
+        }
+        Ok(spec)
+    }
+}
+
+/// Largest averaging factor the automatic range may leave out: the sensor's own
+/// filtering acts over a few to a few tens of samples.
+pub const AUTO_RANGE_MAX_M: usize = 200;
+/// Smallest lag-1 autocorrelation of the τ-averaged rates that counts as coloured.
+pub const ACF_COLOURED: f64 = 0.02;
+
+/// Whether the shortest-τ point of a curve is coloured by the sensor's own filtering:
+/// the lag-1 autocorrelation r₁ of the rate samples lies above max([`ACF_COLOURED`],
+/// 3/√n) (white noise gives r₁ ≈ 0 with standard error 1/√n; Box & Jenkins 1976
+/// §2.1.6) or below −[`ACF_COLOURED`] while above −0.3 (a narrow-band hump; quantization
+/// alone gives r₁ → −½ and is a modelled term). `acf1` is the curve's
+/// [`crate::allan::analysis::ChannelResult::rate_acf1`], `n_samples` the samples behind it.
+pub fn short_tau_coloured(acf1: &[f64], n_samples: usize) -> bool {
+    let Some(&r) = acf1.first() else {
+        return false;
+    };
+    let limit = ACF_COLOURED.max(3.0 / (n_samples.max(1) as f64).sqrt());
+    r.is_finite() && (r > limit || (r < -limit && r > -0.3))
+}
+
+/// Candidate first points of the automatic fit range: the curve's first point, then
+/// points whose averaging factor m has grown by at least half since the previous
+/// candidate, up to m = [`AUTO_RANGE_MAX_M`].
+pub fn auto_range_candidates(m: &[usize]) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut last = 0usize;
+    for (i, &mi) in m.iter().enumerate() {
+        if mi > AUTO_RANGE_MAX_M {
+            break;
+        }
+        if out.is_empty() || 2 * mi >= 3 * last {
+            out.push(i);
+            last = mi;
+        }
+    }
+    out
+}
+
+/// Relative model-error floor f of the fit weights: var σ̂²_i = m_i²·(2/ν_i + f²), so a
+/// point never counts as more precise than f, whatever its EDF.
+pub const MODEL_ERROR_FLOOR: f64 = 0.003;
+
+/// Smallest Gauss-Markov correlation time, in sample intervals: a shorter one is white
+/// noise at every τ the curve has.
+pub const GM_MIN_SAMPLES: f64 = 5.0;
+/// Largest Gauss-Markov correlation time as a fraction of the record: a longer one is a
+/// random walk over the record and its σ and T cannot be separated.
+pub const GM_MAX_RECORD_FRACTION: f64 = 0.1;
+
+/// What the fit needs to know about the record beyond the curve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FitOptions {
+    /// Sample interval, s (bounds the Gauss-Markov correlation time from below at
+    /// [`GM_MIN_SAMPLES`]·τ0).
+    pub tau0_s: Option<f64>,
+    /// Record length, s (bounds the Gauss-Markov correlation time from above at
+    /// [`GM_MAX_RECORD_FRACTION`] of it).
+    pub record_s: Option<f64>,
+    /// Relative model-error floor of the weights (see [`MODEL_ERROR_FLOOR`]).
+    pub model_error_floor: f64,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        FitOptions {
+            tau0_s: None,
+            record_s: None,
+            model_error_floor: MODEL_ERROR_FLOOR,
+        }
+    }
 }
 
 impl NoiseFit {
@@ -522,7 +724,30 @@ pub fn fit_noise(
     cfg: &FitConfig,
     confidence: f64,
 ) -> Result<NoiseFit, AllanError> {
+    fit_noise_opts(tau, avar, edf, cfg, confidence, &FitOptions::default())
+}
+
+/// [`fit_noise`] with the record's sample interval and length (which bound a
+/// Gauss-Markov correlation time to what the record can show) and the weights'
+/// model-error floor. A correlation time that ends at a bound of its search
+/// ([`GM_MIN_SAMPLES`]·τ0 … [`GM_MAX_RECORD_FRACTION`]·record, within a tenth of the
+/// curve's shortest and ten times its longest τ) is reported in
+/// [`NoiseFit::not_identifiable`] and the model refitted without the term.
+pub fn fit_noise_opts(
+    tau: &[f64],
+    avar: &[f64],
+    edf: &[f64],
+    cfg: &FitConfig,
+    confidence: f64,
+    opts: &FitOptions,
+) -> Result<NoiseFit, AllanError> {
     validate_inputs(tau, avar, edf, confidence)?;
+    let floor = opts.model_error_floor;
+    if !(floor.is_finite() && (0.0..1.0).contains(&floor)) {
+        return Err(AllanError::Invalid(format!(
+            "fit: the model-error floor must be in [0, 1), got {floor}"
+        )));
+    }
     let kinds = cfg.linear_terms();
     let n_par = kinds.len() + if cfg.gauss_markov { 2 } else { 0 };
     if n_par == 0 {
@@ -545,15 +770,22 @@ pub fn fit_noise(
 
     // Optional Gauss-Markov: separable search over ln T.
     let mut gm_t: Option<f64> = None;
+    let mut not_identifiable = Vec::new();
     if cfg.gauss_markov {
         let (tmin, tmax) = tau
             .iter()
             .fold((f64::INFINITY, 0.0f64), |(a, b), &t| (a.min(t), b.max(t)));
-        let (lo, hi) = ((tmin / 10.0).ln(), (tmax * 10.0).ln());
+        let t_lo = opts
+            .tau0_s
+            .map_or(tmin / 10.0, |t0| (tmin / 10.0).max(GM_MIN_SAMPLES * t0));
+        let t_hi = opts.record_s.map_or(tmax * 10.0, |r| {
+            (tmax * 10.0).min(GM_MAX_RECORD_FRACTION * r)
+        });
+        let (lo, hi) = (t_lo.ln(), t_hi.ln());
         let objective = |lt: f64| -> f64 {
             let mut c = cols.clone();
             c.push(gm_column(tau, lt.exp()));
-            irls(&c, avar, edf).chi2
+            irls(&c, avar, edf, floor).chi2
         };
         let ngrid = 41;
         let grid: Vec<f64> = (0..ngrid)
@@ -569,11 +801,27 @@ pub fn fit_noise(
         let a = grid[ibest.saturating_sub(1)];
         let b = grid[(ibest + 1).min(ngrid - 1)];
         let (lt, _) = golden_max(|x| -objective(x), a, b);
-        gm_t = Some(lt.exp());
-        cols.push(gm_column(tau, lt.exp()));
+        // Within 2 % of a bound: the curve wants a correlation time outside what the
+        // record can show.
+        if hi - lo < 0.1 || lt - lo < 0.02 || hi - lt < 0.02 {
+            not_identifiable.push(NotIdentifiable {
+                term: TermKind::GaussMarkov,
+                reason: format!(
+                    "correlation time at the bound of its search ({} s; allowed {} … {} s: \
+                     at least {GM_MIN_SAMPLES} sample intervals, at most \
+                     {GM_MAX_RECORD_FRACTION} of the record)",
+                    sig3(lt.exp()),
+                    sig3(t_lo),
+                    sig3(t_hi)
+                ),
+            });
+        } else {
+            gm_t = Some(lt.exp());
+            cols.push(gm_column(tau, lt.exp()));
+        }
     }
 
-    let sol = irls(&cols, avar, edf);
+    let sol = irls(&cols, avar, edf, floor);
     let n = tau.len();
     let n_active = sol.coef.iter().filter(|&&c| c > 0.0).count();
     let dof = n
@@ -621,6 +869,14 @@ pub fn fit_noise(
         not_detected: Vec::new(),
         chi2_reduced,
         n_points: n,
+        fit_range: Some(FitRange {
+            tau_min_s: tau.iter().copied().fold(f64::INFINITY, f64::min),
+            tau_max_s: tau.iter().copied().fold(0.0, f64::max),
+            source: RangeSource::Full,
+            excluded_short: 0,
+            excluded_long: 0,
+        }),
+        not_identifiable,
     };
     let sq_term = |p: f64, var: f64| -> Term {
         let s = (var * scale).max(0.0).sqrt();
@@ -694,6 +950,18 @@ pub fn fit_noise_with_edf<F: Fn(usize, i32) -> f64>(
     cfg: &FitConfig,
     confidence: f64,
 ) -> Result<NoiseFit, AllanError> {
+    fit_noise_with_edf_opts(tau, avar, edf_of, cfg, confidence, &FitOptions::default())
+}
+
+/// [`fit_noise_with_edf`] with [`FitOptions`] (see [`fit_noise_opts`]).
+pub fn fit_noise_with_edf_opts<F: Fn(usize, i32) -> f64>(
+    tau: &[f64],
+    avar: &[f64],
+    edf_of: F,
+    cfg: &FitConfig,
+    confidence: f64,
+    opts: &FitOptions,
+) -> Result<NoiseFit, AllanError> {
     if tau.len() != avar.len() {
         return Err(AllanError::Invalid(format!(
             "fit: tau and avar lengths differ ({} vs {})",
@@ -709,7 +977,7 @@ pub fn fit_noise_with_edf<F: Fn(usize, i32) -> f64>(
             .enumerate()
             .map(|(i, &a)| edf_of(i, a))
             .collect();
-        let f = fit_noise(tau, avar, &edf, cfg, confidence)?;
+        let f = fit_noise_opts(tau, avar, &edf, cfg, confidence, opts)?;
         let next: Vec<i32> = tau.iter().map(|&t| f.dominant_alpha(t)).collect();
         let done = next == alpha;
         fit = Some(f);
@@ -736,6 +1004,15 @@ fn slope_alpha(tau: &[f64], avar: &[f64]) -> Vec<i32> {
         .collect()
 }
 
+/// Three significant digits for messages.
+fn sig3(v: f64) -> String {
+    if v != 0.0 && (v.abs() >= 1e4 || v.abs() < 1e-2) {
+        format!("{v:.2e}")
+    } else {
+        format!("{}", (v * 1e3).round() / 1e3)
+    }
+}
+
 fn gm_column(tau: &[f64], t: f64) -> Vec<f64> {
     tau.iter().map(|&x| gauss_markov_avar(1.0, t, x)).collect()
 }
@@ -748,15 +1025,21 @@ struct IrlsSolution {
     chi2: f64,
 }
 
-/// IRLS with model-based weights w_i = ν_i/(2 m_i²) and an exact NNLS inside.
-fn irls(cols: &[Vec<f64>], avar: &[f64], edf: &[f64]) -> IrlsSolution {
+/// Weight 1/var of an Allan-variance point with EDF ν and model value m: the χ² variance
+/// 2m²/ν (Greenhall & Riley 2003) plus the model-error floor (f·m)².
+fn weight(edf: f64, model: f64, floor: f64) -> f64 {
+    1.0 / (model * model * (2.0 / edf + floor * floor))
+}
+
+/// IRLS with model-based weights w_i = 1/(m_i²(2/ν_i + f²)) and an exact NNLS inside.
+fn irls(cols: &[Vec<f64>], avar: &[f64], edf: &[f64], floor: f64) -> IrlsSolution {
     let n = avar.len();
     let mut model = avar.to_vec();
     let mut w = vec![0.0; n];
     let mut coef = vec![0.0; cols.len()];
     for _ in 0..200 {
         for i in 0..n {
-            w[i] = edf[i] / (2.0 * model[i] * model[i]);
+            w[i] = weight(edf[i], model[i], floor);
         }
         coef = nnls(cols, avar, &w);
         let mut change = 0.0f64;
@@ -772,7 +1055,7 @@ fn irls(cols: &[Vec<f64>], avar: &[f64], edf: &[f64]) -> IrlsSolution {
         }
     }
     for i in 0..n {
-        w[i] = edf[i] / (2.0 * model[i] * model[i]);
+        w[i] = weight(edf[i], model[i], floor);
     }
     let chi2 = (0..n).map(|i| w[i] * (avar[i] - model[i]).powi(2)).sum();
     IrlsSolution {
@@ -1078,6 +1361,8 @@ mod tests {
             not_detected: vec![],
             chi2_reduced: 0.0,
             n_points: 0,
+            fit_range: None,
+            not_identifiable: Vec::new(),
         };
         let avar: Vec<f64> = tau.iter().map(|&t| truth.model_avar(t)).collect();
         let edf = vec![100.0; tau.len()];
@@ -1151,6 +1436,95 @@ mod tests {
         assert!(parsed.white && parsed.bias_instability && parsed.rate_random_walk);
         assert!(!parsed.quantization && !parsed.rate_ramp && !parsed.gauss_markov);
         assert!("n,x".parse::<FitConfig>().is_err());
+    }
+
+    #[test]
+    fn fit_range_spec_parses_and_refuses_bad_values() {
+        let r: FitRangeSpec = "0.2:2000".parse().unwrap();
+        assert_eq!((r.tau_min_s, r.tau_max_s), (Some(0.2), Some(2000.0)));
+        let r: FitRangeSpec = " 0.5 : ".parse().unwrap();
+        assert_eq!((r.tau_min_s, r.tau_max_s), (Some(0.5), None));
+        for bad in ["0.2", "x:1", "1:0.5", "-1:3", "0:3", "1:inf", "2:2"] {
+            let e = bad.parse::<FitRangeSpec>().unwrap_err().to_string();
+            assert!(e.contains("TMIN:TMAX"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn short_tau_colour_from_the_lag1_autocorrelation() {
+        // White: r1 within its standard error; filtered: clearly positive; quantization
+        // (r1 → −½) is a modelled term, not colour.
+        assert!(!short_tau_coloured(&[0.001, 0.0], 1_000_000));
+        assert!(short_tau_coloured(&[0.17, 0.08], 1_000_000));
+        assert!(short_tau_coloured(&[-0.1], 1_000_000));
+        assert!(!short_tau_coloured(&[-0.48], 1_000_000));
+        // Too few samples to call 0.05 significant.
+        assert!(!short_tau_coloured(&[0.05], 1_000));
+        assert!(!short_tau_coloured(&[f64::NAN], 1_000_000));
+        assert!(!short_tau_coloured(&[], 1_000_000));
+        let m: Vec<usize> = (1..=400).collect();
+        let c = auto_range_candidates(&m);
+        let cm: Vec<usize> = c.iter().map(|&i| m[i]).collect();
+        assert_eq!(&cm[..5], &[1, 2, 3, 5, 8]);
+        assert!(c.iter().all(|&i| m[i] <= AUTO_RANGE_MAX_M));
+        assert!(c.windows(2).all(|w| 2 * m[w[1]] >= 3 * m[w[0]]));
+    }
+
+    #[test]
+    fn model_error_floor_caps_the_weight_of_huge_edf() {
+        // Weight of a point with EDF 10⁶ and 10 % floor ≈ that of EDF 200.
+        let w_big = weight(1e6, 1.0, 0.1);
+        let w_200 = weight(200.0, 1.0, 0.0);
+        assert!((w_big / w_200 - 1.0).abs() < 0.01, "{w_big} vs {w_200}");
+        // Small EDF: the floor barely matters.
+        assert!((weight(10.0, 1.0, 0.01) / weight(10.0, 1.0, 0.0) - 1.0).abs() < 1e-3);
+        let t = taus(20, 1.0, 100.0);
+        let opts = FitOptions {
+            model_error_floor: 1.5,
+            ..FitOptions::default()
+        };
+        assert!(fit_noise_opts(&t, &t, &t, &FitConfig::default(), 0.68, &opts).is_err());
+    }
+
+    #[test]
+    fn gauss_markov_shorter_than_a_few_samples_is_not_identifiable() {
+        // White noise plus a Gauss-Markov term of 3 ms at 100 Hz: at every τ of the curve
+        // the term is white noise, so its correlation time runs to the lower bound
+        // (5 samples) and must not come out as a value.
+        let tau = taus(60, 0.01, 1e3);
+        let (n, s, t) = (1e-4, 3e-3, 0.003);
+        let avar: Vec<f64> = tau
+            .iter()
+            .map(|&x| n * n / x + gauss_markov_avar(s, t, x) + 1e-12 * x / 3.0)
+            .collect();
+        let edf = vec![100.0; tau.len()];
+        let cfg: FitConfig = "n,k,gm".parse().unwrap();
+        let opts = FitOptions {
+            tau0_s: Some(0.01),
+            record_s: Some(1e4),
+            model_error_floor: 0.0,
+        };
+        let f = fit_noise_opts(&tau, &avar, &edf, &cfg, 0.683, &opts).unwrap();
+        assert!(f.gauss_markov.is_none(), "{f:?}");
+        let ni = f
+            .not_identifiable
+            .iter()
+            .find(|u| u.term == TermKind::GaussMarkov)
+            .expect("reported");
+        assert!(ni.reason.contains("bound"), "{ni:?}");
+        // The white noise takes the term's power, N² + 2σ²T at τ ≫ T (a little less at
+        // the shortest τ, where τ/T is only 3).
+        let want = (n * n + 2.0 * s * s * t).sqrt();
+        assert!((f.white.unwrap().value / want - 1.0).abs() < 0.05, "{f:?}");
+        // A correlation time inside the bounds is still found.
+        let avar2: Vec<f64> = tau
+            .iter()
+            .map(|&x| n * n / x + gauss_markov_avar(3e-5, 20.0, x))
+            .collect();
+        let f2 = fit_noise_opts(&tau, &avar2, &edf, &cfg, 0.683, &opts).unwrap();
+        let gm = f2.gauss_markov.expect("found");
+        assert!((gm.tau_c_s.value / 20.0 - 1.0).abs() < 1e-3, "{gm:?}");
+        assert!(f2.not_identifiable.is_empty());
     }
 
     #[test]

@@ -32,8 +32,10 @@ use serde::{Deserialize, Serialize};
 use super::AllanError;
 use super::analysis::ChannelResult;
 use super::fit::{
-    BIAS_AVAR_COEF, FitConfig, NoiseFit, SlopeReadings, Term, TermKind, fit_noise_with_edf,
-    gauss_markov_avar_peak, slope_readings,
+    BIAS_AVAR_COEF, CHI2_RED_GOOD, FitConfig, FitOptions, FitRange, FitRangeSpec,
+    MODEL_ERROR_FLOOR, NoiseFit, NotIdentifiable, RangeSource, SlopeReadings, Term, TermKind,
+    UpperLimit, auto_range_candidates, chi2_verdict, fit_noise_with_edf_opts,
+    gauss_markov_avar_peak, short_tau_coloured, slope_readings,
 };
 
 const ALL_TERMS: [TermKind; 6] = [
@@ -259,11 +261,11 @@ pub struct DiscreteNoise {
 pub fn discrete_noise(fit: &NoiseFit, fs: f64) -> DiscreteNoise {
     let dt = 1.0 / fs;
     let v = |t: Option<Term>| t.map(|t| t.value);
-    let bias_instability_gm = v(fit.bias_instability).map(|b| {
+    let bias_instability_gm = v(fit.bias_instability).and_then(|b| {
         let (u_peak, peak) = gauss_markov_avar_peak();
-        let tau_floor = model_minimum_tau(fit);
+        let tau_floor = bias_floor_tau(fit)?;
         let sigma = (BIAS_AVAR_COEF * b * b / peak).sqrt();
-        DiscreteGaussMarkov::new(sigma, tau_floor / u_peak, dt)
+        Some(DiscreteGaussMarkov::new(sigma, tau_floor / u_peak, dt))
     });
     DiscreteNoise {
         sample_rate_hz: fs,
@@ -277,6 +279,18 @@ pub fn discrete_noise(fit: &NoiseFit, fs: f64) -> DiscreteNoise {
         gauss_markov: fit
             .gauss_markov
             .map(|g| DiscreteGaussMarkov::new(g.sigma.value, g.tau_c_s.value, dt)),
+    }
+}
+
+/// τ of the fitted curve's floor when the fit saw it: the model minimum
+/// ([`model_minimum_tau`]) if it lies inside the fitted τ range, None beyond it (the
+/// floor's place, and so the correlation time of a Gauss-Markov stand-in, is then not
+/// known — without a rate random walk the minimum is only the scan's end).
+pub fn bias_floor_tau(fit: &NoiseFit) -> Option<f64> {
+    let t = model_minimum_tau(fit);
+    match fit.fit_range {
+        Some(r) if t > r.tau_max_s => None,
+        _ => Some(t),
     }
 }
 
@@ -398,6 +412,190 @@ pub enum NoiseModelError {
     },
 }
 
+/// How [`NoiseModel::from_curves_with`] chooses the fit range and checks the terms.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelOptions {
+    /// A user-given τ range; None: automatic ([`auto_fit_start`]).
+    pub fit_range: Option<FitRangeSpec>,
+    /// Resolution step of each curve's rate samples (same order as the curves), when
+    /// the samples are quantized ([`super::checks::resolution_step`]).
+    pub resolution: Vec<Option<f64>>,
+    /// Relative model-error floor of the fit weights.
+    pub model_error_floor: f64,
+}
+
+impl Default for ModelOptions {
+    fn default() -> Self {
+        ModelOptions {
+            fit_range: None,
+            resolution: Vec::new(),
+            model_error_floor: MODEL_ERROR_FLOOR,
+        }
+    }
+}
+
+/// Quantization above this multiple of Δτ0/√12 is not taken as quantization.
+pub const QUANTIZATION_RESOLUTION_FACTOR: f64 = 3.0;
+
+/// The curve points inside a user range, [i0, i1).
+fn user_indices(c: &ChannelResult, r: FitRangeSpec) -> Result<(usize, usize), AllanError> {
+    let n = c.points.len();
+    let tol = 1e-9;
+    let lo = r.tau_min_s.map_or(0.0, |t| t * (1.0 - tol));
+    let hi = r.tau_max_s.map_or(f64::INFINITY, |t| t * (1.0 + tol));
+    let i0 = c.points.iter().position(|p| p.tau >= lo).unwrap_or(n);
+    let i1 = c
+        .points
+        .iter()
+        .rposition(|p| p.tau <= hi)
+        .map_or(0, |i| i + 1);
+    if i1 <= i0 {
+        return Err(AllanError::Invalid(format!(
+            "channel '{}': no curve point inside the fit range (the curve spans {} … {} s)",
+            c.name,
+            fmt_num(c.points.first().map_or(0.0, |p| p.tau)),
+            fmt_num(c.points.last().map_or(0.0, |p| p.tau))
+        )));
+    }
+    Ok((i0, i1))
+}
+
+/// The automatic fit range: the fit from each candidate first point (shortest first)
+/// to the curve's end; the first whose χ²_red is at most [`CHI2_RED_GOOD`] over the whole
+/// range *and* over its first half decade (`head(i0, fit)`: where a filter's leftover
+/// shows, and where the whole-range χ²_red would dilute it) — the widest range over which
+/// the model follows the curve within its uncertainty — or, if none is, the candidate
+/// with the smallest χ²_red.
+fn auto_range<F, H>(
+    candidates: &[usize],
+    n: usize,
+    fit_over: &F,
+    head: &H,
+) -> Result<(usize, usize, RangeSource, NoiseFit), AllanError>
+where
+    F: Fn(usize, usize) -> Result<NoiseFit, AllanError>,
+    H: Fn(usize, &NoiseFit) -> f64,
+{
+    let mut best: Option<(usize, NoiseFit)> = None;
+    let mut first_err = None;
+    for &i0 in candidates {
+        match fit_over(i0, n) {
+            Ok(f) => {
+                let good = f.chi2_reduced <= CHI2_RED_GOOD && head(i0, &f) <= CHI2_RED_GOOD;
+                if best
+                    .as_ref()
+                    .is_none_or(|(_, b)| f.chi2_reduced < b.chi2_reduced)
+                {
+                    best = Some((i0, f));
+                }
+                if good {
+                    break;
+                }
+            }
+            Err(e) => {
+                first_err.get_or_insert(e);
+            }
+        }
+    }
+    match (best, first_err) {
+        (Some((i0, f)), _) => {
+            let source = if i0 == 0 {
+                RangeSource::Full
+            } else {
+                RangeSource::Auto
+            };
+            Ok((i0, n, source, f))
+        }
+        (None, Some(e)) => Err(e),
+        (None, None) => Err(AllanError::Invalid("no curve point to fit".into())),
+    }
+}
+
+/// Moves terms the data do not support out of the values: a term whose interval
+/// reaches zero becomes an upper limit (its interval's upper end); a quantization well
+/// above what the resolution step `step` implies is reported not identifiable.
+pub fn keep_physical_terms(fit: &mut NoiseFit, step: Option<f64>, tau0_s: f64) {
+    for kind in [
+        TermKind::Quantization,
+        TermKind::White,
+        TermKind::BiasInstability,
+        TermKind::RateRandomWalk,
+        TermKind::RateRamp,
+    ] {
+        let slot = match kind {
+            TermKind::Quantization => &mut fit.quantization,
+            TermKind::White => &mut fit.white,
+            TermKind::BiasInstability => &mut fit.bias_instability,
+            TermKind::RateRandomWalk => &mut fit.rate_random_walk,
+            TermKind::RateRamp => &mut fit.rate_ramp,
+            TermKind::GaussMarkov => continue,
+        };
+        if let Some(t) = *slot
+            && t.lo <= 0.0
+        {
+            *slot = None;
+            fit.not_detected.push(UpperLimit {
+                term: kind,
+                upper: t.hi,
+            });
+        }
+    }
+    if let Some(g) = fit.gauss_markov
+        && g.sigma.lo <= 0.0
+    {
+        fit.gauss_markov = None;
+        fit.not_detected.push(UpperLimit {
+            term: TermKind::GaussMarkov,
+            upper: g.sigma.hi,
+        });
+    }
+    if let (Some(q), Some(step)) = (fit.quantization, step) {
+        let implied = step * tau0_s / 12f64.sqrt();
+        if q.value > QUANTIZATION_RESOLUTION_FACTOR * implied {
+            fit.quantization = None;
+            fit.not_identifiable.push(NotIdentifiable {
+                term: TermKind::Quantization,
+                reason: format!(
+                    "{:.1}x what the resolution step {} implies ({} (u)·s): the short-τ rise \
+                     is not quantization (filtering, a spectral hump)",
+                    q.value / implied,
+                    fmt_num(step),
+                    fmt_num(implied)
+                ),
+            });
+        }
+    }
+}
+
+/// The fit range, χ²_red and its verdict, as printed under each channel.
+pub fn fit_quality_lines(fit: &NoiseFit) -> String {
+    let mut s = String::new();
+    if let Some(r) = &fit.fit_range {
+        let how = match r.source {
+            RangeSource::Full => "the whole curve".to_string(),
+            RangeSource::User => "set by --fit-range".to_string(),
+            RangeSource::Auto => format!(
+                "automatic: {} short-tau point(s) left out, where the sensor's own filtering \
+                 colours the noise and the model does not apply",
+                r.excluded_short
+            ),
+        };
+        s.push_str(&format!(
+            "  fit range {} … {} s ({} points; {how})\n",
+            fmt_num(r.tau_min_s),
+            fmt_num(r.tau_max_s),
+            fit.n_points
+        ));
+    }
+    let (verdict, warn) = chi2_verdict(fit.chi2_reduced);
+    s.push_str(&format!(
+        "  chi2_red {} — {}{verdict}\n",
+        fmt_num(fit.chi2_reduced),
+        if warn { "WARNING: " } else { "" }
+    ));
+    s
+}
+
 impl NoiseModel {
     /// New empty model.
     pub fn new(
@@ -435,6 +633,37 @@ impl NoiseModel {
         cfg: &FitConfig,
         confidence: f64,
     ) -> Result<NoiseModel, AllanError> {
+        Self::from_curves_with(
+            source,
+            curves,
+            quantities,
+            cfg,
+            confidence,
+            &ModelOptions::default(),
+        )
+    }
+
+    /// [`NoiseModel::from_curves`] over a chosen τ range, with physically possible terms
+    /// only:
+    /// * the fit range is `opts.fit_range` or, by default, the curve without the short τ
+    ///   where the sensor's own filtering colours the noise ([`auto_fit_start`] on
+    ///   [`ChannelResult::rate_acf1`]);
+    /// * a Gauss-Markov correlation time is searched between a few sample intervals and a
+    ///   tenth of the record ([`fit_noise_with_edf_opts`]); one at a bound is reported
+    ///   not identifiable;
+    /// * a term whose confidence interval reaches zero becomes an upper limit
+    ///   ([`NoiseFit::not_detected`]), not a value;
+    /// * a quantization above three times Δτ0/√12 — what angle increments quantized at the
+    ///   rate resolution step Δ (`opts.resolution`) would give (IEEE Std 952-1997 C.1) —
+    ///   is reported not identifiable and dropped.
+    pub fn from_curves_with(
+        source: &str,
+        curves: &[ChannelResult],
+        quantities: &[Quantity],
+        cfg: &FitConfig,
+        confidence: f64,
+        opts: &ModelOptions,
+    ) -> Result<NoiseModel, AllanError> {
         if curves.len() != quantities.len() {
             return Err(AllanError::Invalid(format!(
                 "noise model: {} curves but {} quantities",
@@ -445,16 +674,101 @@ impl NoiseModel {
         let fs = curves.first().map_or(0.0, |c| 1.0 / c.tau0_s);
         let estimator = curves.first().map(|c| c.estimator.name().to_string());
         let mut model = NoiseModel::new(Some(source.to_string()), fs, estimator);
-        for (c, &q) in curves.iter().zip(quantities) {
+        for (k, (c, &q)) in curves.iter().zip(quantities).enumerate() {
             let tau: Vec<f64> = c.points.iter().map(|p| p.tau).collect();
             let avar: Vec<f64> = c.points.iter().map(|p| p.dev * p.dev).collect();
             let adev: Vec<f64> = c.points.iter().map(|p| p.dev).collect();
-            let fit =
-                fit_noise_with_edf(&tau, &avar, |i, a| c.edf_for_alpha(i, a), cfg, confidence)
-                    .map_err(|e| {
-                        AllanError::Invalid(format!("noise fit of channel '{}': {e}", c.name))
-                    })?;
+            let samples: usize = c
+                .segment_phase_points
+                .iter()
+                .map(|n| n.saturating_sub(1))
+                .sum();
+            let fit_opts = FitOptions {
+                tau0_s: Some(c.tau0_s),
+                record_s: Some(samples as f64 * c.tau0_s),
+                model_error_floor: opts.model_error_floor,
+            };
+            let fit_over = |i0: usize, i1: usize| {
+                fit_noise_with_edf_opts(
+                    &tau[i0..i1],
+                    &avar[i0..i1],
+                    |i, a| c.edf_for_alpha(i0 + i, a),
+                    cfg,
+                    confidence,
+                    &fit_opts,
+                )
+            };
+            let named = |e: AllanError, user: bool| {
+                AllanError::Invalid(format!(
+                    "noise fit of channel '{}': {e}{}",
+                    c.name,
+                    if user {
+                        " (choose a wider --fit-range)"
+                    } else {
+                        ""
+                    }
+                ))
+            };
+            let n = tau.len();
+            let (i0, i1, source, mut fit) = match opts.fit_range {
+                Some(r) => {
+                    let (i0, i1) = user_indices(c, r)?;
+                    let f = fit_over(i0, i1).map_err(|e| named(e, true))?;
+                    (i0, i1, RangeSource::User, f)
+                }
+                None => {
+                    let longest = c
+                        .segment_phase_points
+                        .iter()
+                        .max()
+                        .map_or(0, |n| n.saturating_sub(1));
+                    if short_tau_coloured(&c.rate_acf1, longest) {
+                        let m: Vec<usize> = c.points.iter().map(|p| p.m).collect();
+                        // Mean squared normalised residual over the first half decade
+                        // of the range, with the fit's own weights.
+                        let head = |i0: usize, f: &NoiseFit| -> f64 {
+                            let (mut sum, mut k) = (0.0, 0usize);
+                            for i in (i0..n).take_while(|&i| tau[i] <= 3.0 * tau[i0]) {
+                                let model = f.model_avar(tau[i]);
+                                let nu = c.edf_for_alpha(i, f.dominant_alpha(tau[i]));
+                                if model > 0.0 && nu > 0.0 {
+                                    let var =
+                                        model * model * (2.0 / nu + opts.model_error_floor.powi(2));
+                                    sum += (avar[i] - model).powi(2) / var;
+                                    k += 1;
+                                }
+                            }
+                            if k == 0 { 0.0 } else { sum / k as f64 }
+                        };
+                        auto_range(&auto_range_candidates(&m), n, &fit_over, &head)
+                            .map_err(|e| named(e, false))?
+                    } else {
+                        let f = fit_over(0, n).map_err(|e| named(e, false))?;
+                        (0, n, RangeSource::Full, f)
+                    }
+                }
+            };
+            fit.fit_range = Some(FitRange {
+                tau_min_s: tau[i0],
+                tau_max_s: tau[i1 - 1],
+                source,
+                excluded_short: i0,
+                excluded_long: tau.len() - i1,
+            });
+            keep_physical_terms(
+                &mut fit,
+                opts.resolution.get(k).copied().flatten(),
+                c.tau0_s,
+            );
             let mut ch = ChannelNoise::new(&c.name, q, fit, 1.0 / c.tau0_s);
+            if ch.fit.bias_instability.is_some() && ch.discrete.bias_instability_gm.is_none() {
+                ch.fit.not_identifiable.push(NotIdentifiable {
+                    term: TermKind::BiasInstability,
+                    reason: "its Gauss-Markov stand-in: the model's floor lies beyond the \
+                             fitted range, so its correlation time is unknown (B itself stands)"
+                        .into(),
+                });
+            }
             ch.slope_readings = Some(slope_readings(&tau, &adev));
             model.channels.push(ch);
         }
@@ -476,15 +790,15 @@ impl NoiseModel {
         ));
         for c in &self.channels {
             s.push_str(&format!(
-                "\n{} [{}]  (rms log10 residual {:.3})\n",
+                "\n{} [{}]\n",
                 c.name,
                 if c.unit.is_empty() {
                     "data units"
                 } else {
                     &c.unit
-                },
-                c.fit.rms_log10_residual
+                }
             ));
+            s.push_str(&fit_quality_lines(&c.fit));
             s.push_str(&format!(
                 "  {:<18} {:>11} {:>11} {:>11}  {}\n",
                 "term", "value", "lo", "hi", "unit"
@@ -532,6 +846,13 @@ impl NoiseModel {
                     term_label(u.term),
                     fmt_num(val),
                     unit
+                ));
+            }
+            for u in &c.fit.not_identifiable {
+                s.push_str(&format!(
+                    "  {:<18} not identifiable: {}\n",
+                    term_label(u.term),
+                    u.reason
                 ));
             }
             let d = &c.discrete;
@@ -677,6 +998,8 @@ mod tests {
             }],
             chi2_reduced: 0.8,
             n_points: 100,
+            fit_range: None,
+            not_identifiable: Vec::new(),
         }
     }
 
@@ -739,6 +1062,95 @@ mod tests {
         let k = fit.rate_random_walk.unwrap().value;
         let t = model_minimum_tau(&fit);
         assert!((t / (3f64.sqrt() * n / k) - 1.0).abs() < 1e-4, "{t}");
+    }
+
+    #[test]
+    fn unresolved_terms_become_upper_limits_and_quantization_is_checked() {
+        let mut fit = gyro_fit();
+        fit.rate_random_walk = Some(Term {
+            value: 1e-6,
+            lo: 0.0,
+            hi: 3e-6,
+        });
+        fit.quantization = Some(Term {
+            value: 1e-5,
+            lo: 5e-6,
+            hi: 2e-5,
+        });
+        // Step 1e-3 at 100 Hz: Δτ0/√12 = 2.9e-6 < 1e-5/3.
+        keep_physical_terms(&mut fit, Some(1e-3), 0.01);
+        assert!(fit.rate_random_walk.is_none());
+        let k = fit
+            .not_detected
+            .iter()
+            .find(|u| u.term == TermKind::RateRandomWalk)
+            .expect("upper limit");
+        assert_eq!(k.upper, 3e-6);
+        assert!(fit.quantization.is_none());
+        let q = &fit.not_identifiable[0];
+        assert_eq!(q.term, TermKind::Quantization);
+        assert!(q.reason.contains("3.5x"), "{q:?}");
+        // A quantization the step explains stays; no step known: no check.
+        let mut ok = gyro_fit();
+        ok.quantization = Some(Term {
+            value: 5e-6,
+            lo: 4e-6,
+            hi: 6e-6,
+        });
+        keep_physical_terms(&mut ok, Some(1e-3), 0.01);
+        assert!(ok.quantization.is_some() && ok.not_identifiable.is_empty());
+        let mut unknown = fit.clone();
+        unknown.quantization = ok.quantization.map(|t| Term { value: 1.0, ..t });
+        keep_physical_terms(&mut unknown, None, 0.01);
+        assert!(unknown.quantization.is_some());
+        let text = fit_quality_lines(&NoiseFit {
+            chi2_reduced: 12.0,
+            fit_range: Some(FitRange {
+                tau_min_s: 0.2,
+                tau_max_s: 2500.0,
+                source: RangeSource::Auto,
+                excluded_short: 14,
+                excluded_long: 0,
+            }),
+            ..gyro_fit()
+        });
+        assert!(text.contains("fit range 0.20000 … 2500.0 s"), "{text}");
+        assert!(text.contains("14 short-tau point(s) left out"), "{text}");
+        assert!(text.contains("WARNING: poor"), "{text}");
+    }
+
+    #[test]
+    fn bias_stand_in_needs_the_floor_inside_the_range() {
+        // Without a rate random walk the model has no minimum: no stand-in.
+        let fit = NoiseFit {
+            rate_random_walk: None,
+            gauss_markov: None,
+            fit_range: Some(FitRange {
+                tau_min_s: 0.1,
+                tau_max_s: 1e3,
+                source: RangeSource::Full,
+                excluded_short: 0,
+                excluded_long: 0,
+            }),
+            ..gyro_fit()
+        };
+        assert!(bias_floor_tau(&fit).is_none());
+        assert!(discrete_noise(&fit, 100.0).bias_instability_gm.is_none());
+        // With K the floor is at √3·N/K ≈ 1 870 s: inside a range to 10⁴ s.
+        let with_k = NoiseFit {
+            gauss_markov: None,
+            fit_range: fit.fit_range.map(|r| FitRange {
+                tau_max_s: 1e4,
+                ..r
+            }),
+            ..gyro_fit()
+        };
+        assert!(discrete_noise(&with_k, 100.0).bias_instability_gm.is_some());
+        let short = NoiseFit {
+            fit_range: fit.fit_range,
+            ..with_k.clone()
+        };
+        assert!(discrete_noise(&short, 100.0).bias_instability_gm.is_none());
     }
 
     #[test]

@@ -497,6 +497,8 @@ impl GmwmFit {
             not_detected: Vec::new(),
             chi2_reduced: self.objective / dof as f64,
             n_points: self.n_scales,
+            fit_range: None,
+            not_identifiable: Vec::new(),
         }
     }
 }

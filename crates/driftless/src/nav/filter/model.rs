@@ -1109,6 +1109,8 @@ mod tests {
             not_detected: Vec::new(),
             chi2_reduced: 1.0,
             n_points: 10,
+            fit_range: None,
+            not_identifiable: Vec::new(),
         };
         let mut m = NoiseModel::new(None, 200.0, None);
         m.channels.push(ChannelNoise::new(
