@@ -15,8 +15,9 @@ fn tmp_dir() -> PathBuf {
     dir
 }
 
-/// 2^16 samples at 100 Hz of white noise N = 1e-3 plus a Gauss–Markov σ = 1e-3, T = 10 s.
-fn sim_log() -> PathBuf {
+/// 2^16 samples at 100 Hz of white noise N = 1e-3 plus a Gauss–Markov σ = 1e-3, T = 10 s,
+/// in a file of its own per test (`name`): tests run in parallel.
+fn sim_log(name: &str) -> PathBuf {
     let cfg = StaticNoiseConfig {
         sample_rate_hz: 100.0,
         duration_s: 655.36,
@@ -32,7 +33,7 @@ fn sim_log() -> PathBuf {
     for (i, v) in y.iter().enumerate() {
         s.push_str(&format!("{:.2},{v:.9e}\n", i as f64 * 0.01));
     }
-    let p = tmp_dir().join("white_gm.csv");
+    let p = tmp_dir().join(format!("white_gm_{name}.csv"));
     std::fs::write(&p, s).unwrap();
     p
 }
@@ -46,7 +47,7 @@ fn run(args: &[&str]) -> std::process::Output {
 
 #[test]
 fn gmwm_method_reports_the_selected_model_and_saves_it() {
-    let log = sim_log();
+    let log = sim_log("gmwm");
     let path = log.to_str().unwrap();
     let model_path = tmp_dir().join("gmwm_model.toml");
     let mp = model_path.to_str().unwrap();
@@ -116,7 +117,7 @@ fn gmwm_method_reports_the_selected_model_and_saves_it() {
 
 #[test]
 fn allan_stays_the_default_and_bad_gmwm_terms_are_refused() {
-    let log = sim_log();
+    let log = sim_log("default");
     let path = log.to_str().unwrap();
     let out = run(&["allan", path, "--time-column", "time", "--json"]);
     assert!(out.status.success());
