@@ -206,16 +206,19 @@ pub fn run_session(
     let mut fcfg = cfg.filter.clone();
     fcfg.outages_s = cfg.outages.iter().map(|w| (w.start_s, w.end_s)).collect();
     let data_gaps = gnss_data_gaps(&used.time_s);
-    let excluded_from = |t0: f64| {
+    // Convergence periods: after the start t0, and after each outage window and data gap.
+    let excluded_from = |t0: f64, outages: &[OutageWindow]| {
         let gaps = &data_gaps;
+        let windows: Vec<(f64, f64)> = outages
+            .iter()
+            .map(|w| (w.start_s, w.end_s))
+            .chain(gaps.iter().copied())
+            .collect();
         move |t: f64| {
             t < t0 + cfg.converge_s
-                || cfg
-                    .outages
+                || windows
                     .iter()
-                    .map(|w| (w.start_s, w.end_s))
-                    .chain(gaps.iter().copied())
-                    .any(|(a, b)| t > a && t <= b + cfg.reconverge_s)
+                    .any(|&(a, b)| t > a && t <= b + cfg.reconverge_s)
         }
     };
     let mut floors = Vec::new();
@@ -229,13 +232,7 @@ pub fn run_session(
         let mut ffull = fcfg.clone();
         ffull.outages_s.clear();
         let first = run_forward(&imu.epochs, used, init, &ffull)?;
-        let t0 = init.nav.time_s;
-        let excluded = |t: f64| {
-            t < t0 + cfg.converge_s
-                || data_gaps
-                    .iter()
-                    .any(|&(a, b)| t > a && t <= b + cfg.reconverge_s)
-        };
+        let excluded = excluded_from(init.nav.time_s, &[]);
         floors = super::gnss_floor::estimate(
             first
                 .updates
@@ -262,7 +259,7 @@ pub fn run_session(
     let run = run_forward(&imu.epochs, used, init, &fcfg)?;
 
     // Full-GNSS accuracy: prior innovations at accepted position fixes.
-    let excluded = excluded_from(init.nav.time_s);
+    let excluded = excluded_from(init.nav.time_s, &cfg.outages);
     let mut sum2 = 0.0;
     let mut count = 0usize;
     for u in &run.updates {
@@ -502,10 +499,12 @@ fn initialise_at(
     }
     let mut fastest: Option<(f64, f64)> = None;
     let start = (0..n).filter(|&i| usable(i)).find_map(|i| {
-        let sv = velocity(i)?;
         if let Some(t) = start_s {
-            return ((gnss.time_s[i] - t).abs() < 1e-6).then_some((i, sv));
+            return ((gnss.time_s[i] - t).abs() < 1e-6)
+                .then(|| velocity(i).map(|sv| (i, sv)))
+                .flatten();
         }
+        let sv = velocity(i)?;
         if given_yaw.is_some() {
             return Some((i, sv));
         }
