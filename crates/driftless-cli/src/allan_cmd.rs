@@ -69,8 +69,10 @@ pub struct AllanArgs {
     pub method: MethodArg,
     /// Noise terms to fit, comma-separated from q (quantization), n (white: ARW/VRW),
     /// b (bias instability), k (rate random walk), r (rate ramp), gm (one Gauss-Markov).
-    /// Default q,n,b,k,r. With --method gmwm the candidates of the model selection:
-    /// q, n, k, r, gm (up to three Gauss-Markov terms) or gm1..gm4; default q,n,k,r,gm.
+    /// Default q,n,b,k,r,gm (a Gauss-Markov term kept only where the data resolve it;
+    /// q,n,b,k,r for the IEEE 952 terms alone). With --method gmwm the candidates of the
+    /// model selection: q, n, k, r, gm (up to three Gauss-Markov terms) or gm1..gm4;
+    /// default q,n,k,r,gm.
     #[arg(long, value_name = "LIST")]
     pub terms: Option<String>,
     /// Fit the Allan noise terms over TMIN:TMAX seconds only (either side may be empty:
@@ -478,7 +480,7 @@ pub fn noise_method(a: &AllanArgs) -> Result<NoiseMethod> {
         MethodArg::Allan => NoiseMethod::Allan(
             a.terms
                 .as_deref()
-                .unwrap_or("q,n,b,k,r")
+                .unwrap_or("q,n,b,k,r,gm")
                 .parse::<FitConfig>()
                 .context("--terms")?,
             a.fit_range

@@ -112,7 +112,7 @@ fn main_run() -> &'static Vec<SeedResult> {
             .map(|seed| {
                 let y = generate(&sim_cfg(n, b, k, HOURS_18), 1000 + seed).expect("sim");
                 let (fit, tau, adev) = analyse(&y, &fit_cfg(true, true));
-                let (fit_all, _, _) = analyse(&y, &FitConfig::default());
+                let (fit_all, _, _) = analyse(&y, &FitConfig::IEEE_952);
                 let s = slope_readings(&tau, &adev);
                 SeedResult {
                     fit,

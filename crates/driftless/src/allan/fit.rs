@@ -123,15 +123,30 @@ impl std::str::FromStr for FitConfig {
     }
 }
 
+impl FitConfig {
+    /// The five terms of IEEE Std 952-1997: quantization, white noise, bias
+    /// instability, rate random walk, rate ramp.
+    pub const IEEE_952: FitConfig = FitConfig {
+        quantization: true,
+        white: true,
+        bias_instability: true,
+        rate_random_walk: true,
+        rate_ramp: true,
+        gauss_markov: false,
+    };
+}
+
+/// The IEEE 952 terms and one Gauss-Markov term. Real MEMS gyros and accelerometers
+/// often carry a correlated bias whose Allan curve rises and falls again between the
+/// flicker floor and the longest τ (the sums of Gauss-Markov processes their makers and
+/// the GMWM literature model them with); the five IEEE terms can only follow it by
+/// bending a rate random walk through it. The term stays only where the data resolve
+/// it (see `noise_model::fit_supported_terms`).
 impl Default for FitConfig {
     fn default() -> Self {
         FitConfig {
-            quantization: true,
-            white: true,
-            bias_instability: true,
-            rate_random_walk: true,
-            rate_ramp: true,
-            gauss_markov: false,
+            gauss_markov: true,
+            ..FitConfig::IEEE_952
         }
     }
 }
@@ -441,6 +456,9 @@ pub const MODEL_ERROR_FLOOR: f64 = 0.003;
 /// Smallest Gauss-Markov correlation time, in sample intervals: a shorter one is white
 /// noise at every τ the curve has.
 pub const GM_MIN_SAMPLES: f64 = 5.0;
+/// Resolution of the Gauss-Markov correlation-time search in ln T (relative, so
+/// 1e-5·(1 + |ln T|): a few 0.01 % of T, far inside its interval).
+const GM_LN_T_TOL: f64 = 1e-5;
 /// Largest Gauss-Markov correlation time as a fraction of the record: a longer one is a
 /// random walk over the record and its σ and T cannot be separated.
 pub const GM_MAX_RECORD_FRACTION: f64 = 0.1;
@@ -488,6 +506,55 @@ impl NoiseFit {
             s += gauss_markov_avar(gm.sigma.value, gm.tau_c_s.value, tau);
         }
         s
+    }
+
+    /// The band of Allan variances the stated intervals allow at `tau`: every term at
+    /// the lower end of its interval (undetected terms at zero), and every term at the
+    /// upper end (undetected terms at their upper limit; a Gauss-Markov term at the
+    /// correlation time within its interval that gives the most, resp. least). A
+    /// conservative envelope — the terms' errors are not all of one sign — for reading
+    /// where a model's intervals say another recording of the sensor may lie.
+    pub fn model_avar_band(&self, tau: f64) -> (f64, f64) {
+        let (mut lo, mut hi) = (0.0, 0.0);
+        for kind in [
+            TermKind::Quantization,
+            TermKind::White,
+            TermKind::BiasInstability,
+            TermKind::RateRandomWalk,
+            TermKind::RateRamp,
+        ] {
+            let basis = kind.basis(tau);
+            if let Some(t) = self.term(kind) {
+                lo += t.lo * t.lo * basis;
+                hi += t.hi * t.hi * basis;
+            } else if let Some(u) = self.not_detected.iter().find(|u| u.term == kind)
+                && u.upper.is_finite()
+            {
+                hi += u.upper * u.upper * basis;
+            }
+        }
+        if let Some(g) = &self.gauss_markov {
+            let shapes = [g.tau_c_s.lo, g.tau_c_s.value, g.tau_c_s.hi]
+                .map(|tc| gauss_markov_avar(1.0, tc, tau))
+                .into_iter()
+                .filter(|v| v.is_finite());
+            let (smin, smax) =
+                shapes.fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+            if smax > 0.0 {
+                lo += g.sigma.lo * g.sigma.lo * smin;
+                hi += g.sigma.hi * g.sigma.hi * smax;
+            }
+        } else if let Some(u) = self
+            .not_detected
+            .iter()
+            .find(|u| u.term == TermKind::GaussMarkov)
+            && u.upper.is_finite()
+        {
+            // No correlation time was fitted: the largest a σ at the upper limit can
+            // give at this τ is its peak over T (0.381·σ² at T ≈ τ/1.89).
+            hi += u.upper * u.upper * gauss_markov_avar_peak().1;
+        }
+        (lo, hi)
     }
 
     /// The fitted term of a kind (Gauss-Markov: its σ).
@@ -729,10 +796,11 @@ pub fn fit_noise(
 
 /// [`fit_noise`] with the record's sample interval and length (which bound a
 /// Gauss-Markov correlation time to what the record can show) and the weights'
-/// model-error floor. A correlation time that ends at a bound of its search
-/// ([`GM_MIN_SAMPLES`]·τ0 … [`GM_MAX_RECORD_FRACTION`]·record, within a tenth of the
-/// curve's shortest and ten times its longest τ) is reported in
-/// [`NoiseFit::not_identifiable`] and the model refitted without the term.
+/// model-error floor. A correlation time that ends at a bound of its search — from
+/// the longer of [`GM_MIN_SAMPLES`]·τ0 and the curve's shortest τ (a shorter one falls
+/// as 1/τ over the whole curve, like white noise, and would trade places with N) to the
+/// shorter of [`GM_MAX_RECORD_FRACTION`]·record and ten times the longest τ — is
+/// reported in [`NoiseFit::not_identifiable`] and the model refitted without the term.
 pub fn fit_noise_opts(
     tau: &[f64],
     avar: &[f64],
@@ -777,7 +845,7 @@ pub fn fit_noise_opts(
             .fold((f64::INFINITY, 0.0f64), |(a, b), &t| (a.min(t), b.max(t)));
         let t_lo = opts
             .tau0_s
-            .map_or(tmin / 10.0, |t0| (tmin / 10.0).max(GM_MIN_SAMPLES * t0));
+            .map_or(tmin / 10.0, |t0| tmin.max(GM_MIN_SAMPLES * t0));
         let t_hi = opts.record_s.map_or(tmax * 10.0, |r| {
             (tmax * 10.0).min(GM_MAX_RECORD_FRACTION * r)
         });
@@ -787,7 +855,7 @@ pub fn fit_noise_opts(
             c.push(gm_column(tau, lt.exp()));
             irls(&c, avar, edf, floor).chi2
         };
-        let ngrid = 41;
+        let ngrid = 21;
         let grid: Vec<f64> = (0..ngrid)
             .map(|i| lo + (hi - lo) * i as f64 / (ngrid - 1) as f64)
             .collect();
@@ -800,20 +868,30 @@ pub fn fit_noise_opts(
             .unwrap_or(0);
         let a = grid[ibest.saturating_sub(1)];
         let b = grid[(ibest + 1).min(ngrid - 1)];
-        let (lt, _) = golden_max(|x| -objective(x), a, b);
+        let (lt, _) = golden_max_tol(|x| -objective(x), a, b, GM_LN_T_TOL);
         // Within 2 % of a bound: the curve wants a correlation time outside what the
         // record can show.
         if hi - lo < 0.1 || lt - lo < 0.02 || hi - lt < 0.02 {
-            not_identifiable.push(NotIdentifiable {
-                term: TermKind::GaussMarkov,
-                reason: format!(
+            let reason = if hi - lo >= 0.1 && lt - lo < 0.02 && (t_lo - tmin).abs() <= 1e-12 * tmin
+            {
+                format!(
+                    "no correlated hump: the best correlation time is below the fitted \
+                     range's first τ ({} s), where it is white noise",
+                    sig3(t_lo)
+                )
+            } else {
+                format!(
                     "correlation time at the bound of its search ({} s; allowed {} … {} s: \
-                     at least {GM_MIN_SAMPLES} sample intervals, at most \
-                     {GM_MAX_RECORD_FRACTION} of the record)",
+                     at least {GM_MIN_SAMPLES} sample intervals and the range's first τ, at \
+                     most {GM_MAX_RECORD_FRACTION} of the record)",
                     sig3(lt.exp()),
                     sig3(t_lo),
                     sig3(t_hi)
-                ),
+                )
+            };
+            not_identifiable.push(NotIdentifiable {
+                term: TermKind::GaussMarkov,
+                reason,
             });
         } else {
             gm_t = Some(lt.exp());
@@ -1067,80 +1145,82 @@ fn irls(cols: &[Vec<f64>], avar: &[f64], edf: &[f64], floor: f64) -> IrlsSolutio
     }
 }
 
-/// Exact non-negative weighted least squares for a handful of columns: try every support,
-/// keep the feasible one with the smallest weighted residual.
-fn nnls(cols: &[Vec<f64>], y: &[f64], w: &[f64]) -> Vec<f64> {
+/// Most columns of the small least-squares systems of the fit: five linear terms, the
+/// Gauss-Markov σ² and its ln T, with room to spare. The systems live on the stack: the
+/// fit solves thousands of them per channel (IRLS iterations × supports × the
+/// Gauss-Markov search), and allocating each cost more than solving it.
+const MAXP: usize = 8;
+
+/// Column-scaled weighted normal equations A_jk = Σ w c_j c_k/(s_j s_k),
+/// b_j = Σ w c_j y/s_j, yᵀWy, with s_j = √(Σ w c_j²) (unit diagonal, so a pivot test
+/// can tell near-collinear columns).
+struct NormalEquations {
+    p: usize,
+    a: [[f64; MAXP]; MAXP],
+    b: [f64; MAXP],
+    yy: f64,
+    s: [f64; MAXP],
+}
+
+/// The normal equations of `cols` (at most [`MAXP`]) against `y`, or None with more.
+fn normal_equations(cols: &[Vec<f64>], y: &[f64], w: &[f64]) -> Option<NormalEquations> {
     let p = cols.len();
-    let (a, b, yy) = normal_equations(cols, y, w);
-    let mut best = (yy, vec![0.0; p]);
-    for mask in 1u32..(1u32 << p) {
-        let idx: Vec<usize> = (0..p).filter(|j| mask & (1 << j) != 0).collect();
-        let sub_a: Vec<Vec<f64>> = idx
-            .iter()
-            .map(|&r| idx.iter().map(|&c| a[r][c]).collect())
-            .collect();
-        let sub_b: Vec<f64> = idx.iter().map(|&r| b[r]).collect();
-        let Some(x) = solve_spd(&sub_a, &sub_b) else {
-            continue;
-        };
-        if x.iter().any(|&v| v.is_nan() || v <= 0.0) {
-            continue;
-        }
-        // Residual at the LS optimum: yᵀWy − xᵀb.
-        let wssr = yy - x.iter().zip(&sub_b).map(|(u, v)| u * v).sum::<f64>();
-        if wssr < best.0 {
-            let mut full = vec![0.0; p];
-            for (k, &j) in idx.iter().enumerate() {
-                full[j] = x[k];
-            }
-            best = (wssr, full);
-        }
+    if p > MAXP {
+        return None;
     }
-    // Undo the column scaling of `normal_equations`.
-    let scales = column_scales(cols, w);
-    best.1.iter().zip(&scales).map(|(x, s)| x / s).collect()
-}
-
-fn column_scales(cols: &[Vec<f64>], w: &[f64]) -> Vec<f64> {
-    cols.iter()
-        .map(|c| {
-            let s = c.iter().zip(w).map(|(v, w)| w * v * v).sum::<f64>().sqrt();
-            if s > 0.0 && s.is_finite() { s } else { 1.0 }
-        })
-        .collect()
-}
-
-/// Column-scaled weighted normal equations (A, b, yᵀWy), A_jk = Σ w c_j c_k/(s_j s_k).
-fn normal_equations(cols: &[Vec<f64>], y: &[f64], w: &[f64]) -> (Vec<Vec<f64>>, Vec<f64>, f64) {
-    let p = cols.len();
-    let s = column_scales(cols, w);
-    let mut a = vec![vec![0.0; p]; p];
-    let mut b = vec![0.0; p];
+    let mut ne = NormalEquations {
+        p,
+        a: [[0.0; MAXP]; MAXP],
+        b: [0.0; MAXP],
+        yy: 0.0,
+        s: [1.0; MAXP],
+    };
+    for (j, c) in cols.iter().enumerate() {
+        let s = c.iter().zip(w).map(|(v, w)| w * v * v).sum::<f64>().sqrt();
+        ne.s[j] = if s > 0.0 && s.is_finite() { s } else { 1.0 };
+    }
     for j in 0..p {
         for k in 0..=j {
             let v: f64 = (0..y.len())
                 .map(|i| w[i] * cols[j][i] * cols[k][i])
                 .sum::<f64>()
-                / (s[j] * s[k]);
-            a[j][k] = v;
-            a[k][j] = v;
+                / (ne.s[j] * ne.s[k]);
+            ne.a[j][k] = v;
+            ne.a[k][j] = v;
         }
-        b[j] = (0..y.len()).map(|i| w[i] * cols[j][i] * y[i]).sum::<f64>() / s[j];
+        ne.b[j] = (0..y.len()).map(|i| w[i] * cols[j][i] * y[i]).sum::<f64>() / ne.s[j];
     }
-    let yy = (0..y.len()).map(|i| w[i] * y[i] * y[i]).sum();
-    (a, b, yy)
+    ne.yy = (0..y.len()).map(|i| w[i] * y[i] * y[i]).sum();
+    Some(ne)
 }
 
-/// Cholesky solve of a small symmetric positive-definite system; None if (near) singular.
-fn solve_spd(a: &[Vec<f64>], b: &[f64]) -> Option<Vec<f64>> {
-    let l = cholesky(a)?;
-    let n = b.len();
-    let mut y = vec![0.0; n];
+/// Cholesky solve of the sub-system of `a`, `b` on the columns `idx`; None if (near)
+/// singular: the scaled matrix has a unit diagonal, so a pivot below 1e-12 is a
+/// near-collinear support.
+fn solve_subset(a: &[[f64; MAXP]; MAXP], b: &[f64; MAXP], idx: &[usize]) -> Option<[f64; MAXP]> {
+    let n = idx.len();
+    let mut l = [[0.0; MAXP]; MAXP];
+    for i in 0..n {
+        for j in 0..=i {
+            let s: f64 = (0..j).map(|k| l[i][k] * l[j][k]).sum();
+            let aij = a[idx[i]][idx[j]];
+            if i == j {
+                let d = aij - s;
+                if d.is_nan() || d <= 1e-12 {
+                    return None;
+                }
+                l[i][i] = d.sqrt();
+            } else {
+                l[i][j] = (aij - s) / l[j][j];
+            }
+        }
+    }
+    let mut y = [0.0; MAXP];
     for i in 0..n {
         let s: f64 = (0..i).map(|k| l[i][k] * y[k]).sum();
-        y[i] = (b[i] - s) / l[i][i];
+        y[i] = (b[idx[i]] - s) / l[i][i];
     }
-    let mut x = vec![0.0; n];
+    let mut x = [0.0; MAXP];
     for i in (0..n).rev() {
         let s: f64 = (i + 1..n).map(|k| l[k][i] * x[k]).sum();
         x[i] = (y[i] - s) / l[i][i];
@@ -1148,25 +1228,85 @@ fn solve_spd(a: &[Vec<f64>], b: &[f64]) -> Option<Vec<f64>> {
     Some(x)
 }
 
-fn cholesky(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
-    let n = a.len();
-    let mut l = vec![vec![0.0; n]; n];
-    for i in 0..n {
-        for j in 0..=i {
-            let s: f64 = (0..j).map(|k| l[i][k] * l[j][k]).sum();
-            if i == j {
-                let d = a[i][i] - s;
-                // Scaled matrix has a unit diagonal: reject near-collinear supports.
-                if d.is_nan() || d <= 1e-12 {
-                    return None;
+/// Exact non-negative weighted least squares for a handful of columns, by the active-set
+/// method of Lawson & Hanson (1974, ch. 23) on the normal equations (the form of Bro &
+/// De Jong 1997): move into the passive set the column whose gradient b − Ax is largest
+/// and positive, solve the passive sub-system, step back along the segment to the
+/// feasible region when a coefficient turns non-positive and release it; stop when no
+/// gradient is positive. The problem is convex, so this is the optimum the enumeration
+/// of every support would find, at a few sub-system solves instead of 2^p. A column
+/// nearly collinear with the passive set is left out.
+fn nnls(cols: &[Vec<f64>], y: &[f64], w: &[f64]) -> Vec<f64> {
+    let Some(ne) = normal_equations(cols, y, w) else {
+        return vec![0.0; cols.len()];
+    };
+    let p = ne.p;
+    let scale = ne.b[..p].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let tol = 1e-12 * (1.0 + scale);
+    let mut x = [0.0; MAXP];
+    let mut passive = [false; MAXP];
+    let mut barred = [false; MAXP];
+    let mut idx = [0usize; MAXP];
+    let gradient =
+        |x: &[f64; MAXP], j: usize| ne.b[j] - (0..p).map(|k| ne.a[j][k] * x[k]).sum::<f64>();
+    for _ in 0..(4 * MAXP) {
+        let Some(j) = (0..p)
+            .filter(|&j| !passive[j] && !barred[j])
+            .map(|j| (j, gradient(&x, j)))
+            .filter(|&(_, g)| g > tol)
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(j, _)| j)
+        else {
+            break;
+        };
+        passive[j] = true;
+        let mut entered = true;
+        for _ in 0..(4 * MAXP) {
+            let mut k = 0;
+            for (c, &on) in passive[..p].iter().enumerate() {
+                if on {
+                    idx[k] = c;
+                    k += 1;
                 }
-                l[i][i] = d.sqrt();
-            } else {
-                l[i][j] = (a[i][j] - s) / l[j][j];
+            }
+            let Some(sol) = solve_subset(&ne.a, &ne.b, &idx[..k]) else {
+                // Collinear with the passive set: leave the newcomer out for good.
+                passive[j] = false;
+                barred[j] = true;
+                entered = false;
+                break;
+            };
+            let mut z = [0.0; MAXP];
+            for t in 0..k {
+                z[idx[t]] = sol[t];
+            }
+            if idx[..k].iter().all(|&c| z[c] > 0.0) {
+                x = z;
+                break;
+            }
+            // Step from x towards z as far as feasibility allows.
+            let alpha = idx[..k]
+                .iter()
+                .filter(|&&c| z[c] <= 0.0)
+                .map(|&c| x[c] / (x[c] - z[c]))
+                .fold(f64::INFINITY, f64::min);
+            for &c in &idx[..k] {
+                x[c] += alpha * (z[c] - x[c]);
+                if x[c] <= tol {
+                    x[c] = 0.0;
+                    passive[c] = false;
+                }
+            }
+            if !passive[..p].iter().any(|&on| on) {
+                break;
             }
         }
+        if !entered {
+            continue;
+        }
     }
-    Some(l)
+    // Undo the column scaling.
+    (0..p).map(|j| x[j].max(0.0) / ne.s[j]).collect()
 }
 
 /// (JᵀWJ)⁻¹ for the given Jacobian columns, None if singular.
@@ -1176,15 +1316,15 @@ fn covariance(jac: &[Vec<f64>], w: &[f64]) -> Option<Vec<Vec<f64>>> {
         return Some(Vec::new());
     }
     let dummy = vec![0.0; w.len()];
-    let (a, _, _) = normal_equations(jac, &dummy, w);
-    let s = column_scales(jac, w);
+    let ne = normal_equations(jac, &dummy, w)?;
+    let all: Vec<usize> = (0..p).collect();
     let mut inv = vec![vec![0.0; p]; p];
     for k in 0..p {
-        let mut e = vec![0.0; p];
+        let mut e = [0.0; MAXP];
         e[k] = 1.0;
-        let col = solve_spd(&a, &e)?;
+        let col = solve_subset(&ne.a, &e, &all)?;
         for j in 0..p {
-            inv[j][k] = col[j] / (s[j] * s[k]);
+            inv[j][k] = col[j] / (ne.s[j] * ne.s[k]);
         }
     }
     Some(inv)
@@ -1196,26 +1336,33 @@ fn upper_limit(cols: &[Vec<f64>], sol: &IrlsSolution, j: usize, z: f64, scale: f
     let mut idx: Vec<usize> = (0..cols.len()).filter(|&k| sol.coef[k] > 0.0).collect();
     idx.push(j);
     let sub: Vec<Vec<f64>> = idx.iter().map(|&k| cols[k].clone()).collect();
-    let (a, b, _) = normal_equations(&sub, &sol.data, &sol.w);
-    let s = column_scales(&sub, &sol.w);
     let last = idx.len() - 1;
-    let (Some(x), Some(cov)) = (solve_spd(&a, &b), covariance(&sub, &sol.w)) else {
+    let all: Vec<usize> = (0..sub.len()).collect();
+    let Some(ne) = normal_equations(&sub, &sol.data, &sol.w) else {
         return f64::NAN;
     };
-    let theta = x[last] / s[last];
+    let (Some(x), Some(cov)) = (solve_subset(&ne.a, &ne.b, &all), covariance(&sub, &sol.w)) else {
+        return f64::NAN;
+    };
+    let theta = x[last] / ne.s[last];
     let sd = (cov[last][last] * scale).max(0.0).sqrt();
     (theta.max(0.0) + z * sd).sqrt()
 }
 
 /// Golden-section maximisation of a unimodal function on [a, b]; returns (x*, f(x*)).
 pub(crate) fn golden_max<F: Fn(f64) -> f64>(f: F, a: f64, b: f64) -> (f64, f64) {
+    golden_max_tol(f, a, b, 1e-10)
+}
+
+/// [`golden_max`] stopping when the bracket is narrower than `tol`·(1 + |a| + |b|).
+pub(crate) fn golden_max_tol<F: Fn(f64) -> f64>(f: F, a: f64, b: f64, tol: f64) -> (f64, f64) {
     let g = (5f64.sqrt() - 1.0) / 2.0;
     let (mut a, mut b) = (a.min(b), a.max(b));
     let mut c = b - g * (b - a);
     let mut d = a + g * (b - a);
     let (mut fc, mut fd) = (f(c), f(d));
     for _ in 0..80 {
-        if (b - a).abs() < 1e-10 * (1.0 + a.abs() + b.abs()) {
+        if (b - a).abs() < tol * (1.0 + a.abs() + b.abs()) {
             break;
         }
         if fc > fd {
@@ -1301,6 +1448,102 @@ mod tests {
         (0..n)
             .map(|i| lo * (hi / lo).powf(i as f64 / (n - 1) as f64))
             .collect()
+    }
+
+    /// The exact NNLS by enumeration of every support, as a reference.
+    fn nnls_by_enumeration(cols: &[Vec<f64>], y: &[f64], w: &[f64]) -> Vec<f64> {
+        let ne = normal_equations(cols, y, w).expect("small");
+        let p = ne.p;
+        let mut best = (ne.yy, [0.0; MAXP]);
+        for mask in 1u32..(1 << p) {
+            let idx: Vec<usize> = (0..p).filter(|j| mask & (1 << j) != 0).collect();
+            let Some(x) = solve_subset(&ne.a, &ne.b, &idx) else {
+                continue;
+            };
+            if x[..idx.len()].iter().any(|&v| v.is_nan() || v <= 0.0) {
+                continue;
+            }
+            let wssr = ne.yy - (0..idx.len()).map(|t| x[t] * ne.b[idx[t]]).sum::<f64>();
+            if wssr < best.0 {
+                let mut c = [0.0; MAXP];
+                for (t, &j) in idx.iter().enumerate() {
+                    c[j] = x[t];
+                }
+                best = (wssr, c);
+            }
+        }
+        (0..p).map(|j| best.1[j] / ne.s[j]).collect()
+    }
+
+    #[test]
+    fn active_set_nnls_matches_the_enumeration_of_supports() {
+        // Allan-variance bases with noisy data from models with terms switched off, so
+        // the unconstrained optimum is often infeasible.
+        let tau = taus(60, 0.05, 3000.0);
+        let kinds = [
+            TermKind::Quantization,
+            TermKind::White,
+            TermKind::BiasInstability,
+            TermKind::RateRandomWalk,
+            TermKind::RateRamp,
+        ];
+        let mut cols: Vec<Vec<f64>> = kinds
+            .iter()
+            .map(|k| tau.iter().map(|&t| k.basis(t)).collect())
+            .collect();
+        cols.push(gm_column(&tau, 30.0));
+        let mut state = 12345u64;
+        let mut uniform = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut zeros = 0;
+        for trial in 0..300 {
+            let truth: Vec<f64> = (0..cols.len())
+                .map(|j| {
+                    if j != 1 && uniform() < 0.4 {
+                        0.0
+                    } else {
+                        [1e-12, 1e-8, 1e-10, 1e-14, 1e-18, 1e-10][j] * (0.2 + uniform())
+                    }
+                })
+                .collect();
+            let y: Vec<f64> = (0..tau.len())
+                .map(|i| {
+                    let m: f64 = cols.iter().zip(&truth).map(|(c, t)| c[i] * t).sum();
+                    m * (1.0 + 0.3 * (uniform() - 0.5))
+                })
+                .collect();
+            let w: Vec<f64> = y.iter().map(|v| 1.0 / (v * v)).collect();
+            let fast = nnls(&cols, &y, &w);
+            let exact = nnls_by_enumeration(&cols, &y, &w);
+            zeros += exact.iter().filter(|&&c| c == 0.0).count();
+            let ssr = |c: &[f64]| -> f64 {
+                (0..tau.len())
+                    .map(|i| {
+                        let m: f64 = cols.iter().zip(c).map(|(col, x)| col[i] * x).sum();
+                        w[i] * (y[i] - m).powi(2)
+                    })
+                    .sum()
+            };
+            assert!(fast.iter().all(|&c| c >= 0.0), "trial {trial}: {fast:?}");
+            let (a, b) = (ssr(&fast), ssr(&exact));
+            assert!(a <= b * (1.0 + 1e-9) + 1e-300, "trial {trial}: {a} vs {b}");
+            for (f, e) in fast.iter().zip(&exact) {
+                assert!(
+                    (f - e).abs() <= 1e-6 * e.abs().max(1e-30)
+                        || (*f == 0.0 && *e == 0.0)
+                        || a <= b,
+                    "trial {trial}: {fast:?} vs {exact:?}"
+                );
+            }
+        }
+        assert!(
+            zeros > 100,
+            "the trials must exercise the constraint: {zeros}"
+        );
     }
 
     #[test]

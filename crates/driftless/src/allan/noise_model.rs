@@ -422,6 +422,9 @@ pub struct ModelOptions {
     pub resolution: Vec<Option<f64>>,
     /// Relative model-error floor of the fit weights.
     pub model_error_floor: f64,
+    /// The automatic range ends at the last τ whose σ̂ is known to this relative
+    /// standard uncertainty ([`auto_fit_end`]); None: at the curve's end.
+    pub curve_precision: Option<f64>,
 }
 
 impl Default for ModelOptions {
@@ -430,8 +433,45 @@ impl Default for ModelOptions {
             fit_range: None,
             resolution: Vec::new(),
             model_error_floor: MODEL_ERROR_FLOOR,
+            curve_precision: Some(CURVE_PRECISION),
         }
     }
+}
+
+/// Relative half-width of the 68.3 % interval of σ̂(τ) up to which the automatic fit
+/// range reaches: a model can be held to ±10 % of the curve only where the curve itself
+/// is known to 10 %.
+pub const CURVE_PRECISION: f64 = 0.10;
+/// Confidence level of the curve interval [`CURVE_PRECISION`] applies to (one σ).
+pub const CURVE_PRECISION_CONFIDENCE: f64 = 0.683;
+
+/// Fewest curve points the automatic range keeps, whatever their precision.
+pub const AUTO_RANGE_MIN_POINTS: usize = 12;
+
+/// End (exclusive) of the automatic fit range: before the first point whose 68.3 %
+/// interval reaches beyond ±`precision` of σ̂, with the EDF ν of the long-τ noise types
+/// (flicker and random-walk FM, the smaller of the two, so that the end does not depend
+/// on a noise identification that is itself uncertain at long τ). σ̂² is ≈ σ²·χ²_ν/ν, so
+/// the interval's wider, upper side is σ̂·√(ν/χ²_ν(0.1587)) (NIST SP 1065 §5.3); it stays
+/// within +10 % for ν ≳ 68 — a few tens of independent averages. Beyond it the points
+/// scatter by more than the tolerance a model is held to, and on real sensors the
+/// longest τ carry slow effects (temperature, run-to-run changes of the bias) that no
+/// stationary term describes; they stay on the curve, with their intervals, but do not
+/// shape the model. At least [`AUTO_RANGE_MIN_POINTS`]
+/// points are kept.
+pub fn auto_fit_end(c: &ChannelResult, precision: f64) -> usize {
+    let n = c.points.len();
+    // The lower χ² point of the two-sided interval.
+    let p_lo = 0.5 * (1.0 - CURVE_PRECISION_CONFIDENCE);
+    let end = (0..n)
+        .position(|i| {
+            let nu = c.edf_for_alpha(i, -1).min(c.edf_for_alpha(i, -2));
+            !(nu.is_finite()
+                && nu > 0.0
+                && (nu / super::ci::chi2::chi2_quantile(p_lo, nu)).sqrt() <= 1.0 + precision)
+        })
+        .unwrap_or(n);
+    end.max(AUTO_RANGE_MIN_POINTS).min(n)
 }
 
 /// Quantization above this multiple of Δτ0/√12 is not taken as quantization.
@@ -458,6 +498,37 @@ fn user_indices(c: &ChannelResult, r: FitRangeSpec) -> Result<(usize, usize), Al
         )));
     }
     Ok((i0, i1))
+}
+
+/// Widens the interval of the white-noise term — the term the start of the range
+/// decides — by the bias the sensor's filtering may leave at the start. That leftover
+/// decays as 1/τ (a low-pass of time constant T_f changes σ²(τ) of white noise by
+/// ≈ −3N²T_f/τ²; a decimation filter's is of the same form), so the bias of the fitted
+/// θ = N² from a start τ_s is b(τ_s) ∝ 1/τ_s, and the fit from the next start r·τ_s
+/// (`later`, r = `ratio` > 1) differs from the one from τ_s (`at_start`, same terms) by
+/// Δ = θ_later − θ_start = −b(τ_s)·(1 − 1/r); hence b(τ_s) = −Δ·r/(r − 1) (Richardson's
+/// extrapolation). The bias is systematic and its sign known, so the interval is
+/// extended on that side by |b| (added to the statistical half-width, not in
+/// quadrature); the value itself is left as fitted.
+pub fn widen_for_the_start(fit: &mut NoiseFit, at_start: &NoiseFit, later: &NoiseFit, ratio: f64) {
+    let (Some(t), Some(s0), Some(l)) = (fit.white.as_mut(), at_start.white, later.white) else {
+        return;
+    };
+    if !(ratio.is_finite() && ratio > 1.0) {
+        return;
+    }
+    let theta = t.value * t.value;
+    let (lo, hi) = (t.lo * t.lo, t.hi * t.hi);
+    // The truth lies on the side the later start moves towards.
+    let shift = (l.value * l.value - s0.value * s0.value) * ratio / (ratio - 1.0);
+    if !(shift.is_finite() && lo.is_finite() && hi.is_finite() && lo <= theta && theta <= hi) {
+        return;
+    }
+    if shift > 0.0 {
+        t.hi = (hi + shift).sqrt();
+    } else {
+        t.lo = (lo + shift).max(0.0).sqrt();
+    }
 }
 
 /// The automatic fit range: the fit from each candidate first point (shortest first)
@@ -511,60 +582,144 @@ where
     }
 }
 
-/// Moves terms the data do not support out of the values: a term whose interval
-/// reaches zero becomes an upper limit (its interval's upper end); a quantization well
-/// above what the resolution step `step` implies is reported not identifiable.
-pub fn keep_physical_terms(fit: &mut NoiseFit, step: Option<f64>, tau0_s: f64) {
-    for kind in [
+/// What a term the data do not support is reported as instead of a value.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Unsupported {
+    /// Its interval reaches zero: the upper end of the interval is the upper limit.
+    UpperLimit(UpperLimit),
+    /// Its value cannot be what the term describes (see [`least_supported_term`]).
+    NotIdentifiable(NotIdentifiable),
+}
+
+/// The term of `fit` the data support least, if any does not stand:
+/// * a quantization above [`QUANTIZATION_RESOLUTION_FACTOR`]·Δτ0/√12 — what angle
+///   increments quantized at the rate resolution step Δ = `step` would give (IEEE Std
+///   952-1997 C.1) — is not quantization (filtering, a spectral hump): not identifiable;
+/// * otherwise, of the terms whose interval reaches zero, the one with the smallest
+///   significance θ/(z·s_θ) (θ the squared coefficient, z·s_θ its interval half-width,
+///   so θ/(z·s_θ) = v²/(hi² − v²)): an upper limit at its interval's upper end.
+pub fn least_supported_term(
+    fit: &NoiseFit,
+    step: Option<f64>,
+    tau0_s: f64,
+) -> Option<(TermKind, Unsupported)> {
+    if let (Some(q), Some(step)) = (fit.quantization, step) {
+        let implied = step * tau0_s / 12f64.sqrt();
+        if q.value > QUANTIZATION_RESOLUTION_FACTOR * implied {
+            return Some((
+                TermKind::Quantization,
+                Unsupported::NotIdentifiable(NotIdentifiable {
+                    term: TermKind::Quantization,
+                    reason: format!(
+                        "{:.1}x what the resolution step {} implies ({} (u)·s): the short-τ \
+                         rise is not quantization (filtering, a spectral hump)",
+                        q.value / implied,
+                        fmt_num(step),
+                        fmt_num(implied)
+                    ),
+                }),
+            ));
+        }
+    }
+    let significance = |t: &Term| {
+        let half = t.hi * t.hi - t.value * t.value;
+        if half > 0.0 {
+            t.value * t.value / half
+        } else {
+            f64::INFINITY
+        }
+    };
+    let mut candidates: Vec<(TermKind, Term)> = [
         TermKind::Quantization,
         TermKind::White,
         TermKind::BiasInstability,
         TermKind::RateRandomWalk,
         TermKind::RateRamp,
-    ] {
-        let slot = match kind {
-            TermKind::Quantization => &mut fit.quantization,
-            TermKind::White => &mut fit.white,
-            TermKind::BiasInstability => &mut fit.bias_instability,
-            TermKind::RateRandomWalk => &mut fit.rate_random_walk,
-            TermKind::RateRamp => &mut fit.rate_ramp,
-            TermKind::GaussMarkov => continue,
+    ]
+    .into_iter()
+    .filter_map(|k| fit.term(k).map(|t| (k, t)))
+    .collect();
+    if let Some(g) = fit.gauss_markov {
+        candidates.push((TermKind::GaussMarkov, g.sigma));
+    }
+    candidates
+        .into_iter()
+        .filter(|(_, t)| t.lo <= 0.0)
+        .min_by(|a, b| significance(&a.1).total_cmp(&significance(&b.1)))
+        .map(|(kind, t)| {
+            (
+                kind,
+                Unsupported::UpperLimit(UpperLimit {
+                    term: kind,
+                    upper: t.hi,
+                }),
+            )
+        })
+}
+
+/// The fit with physically possible, resolved terms only, by backward elimination: fit
+/// with `cfg`, drop the [`least_supported_term`], refit without it and repeat until every
+/// remaining term stands. Each dropped term is reported (upper limit or not
+/// identifiable) from the fit that still had it; the returned fit's values, χ²_red and
+/// model curve are those of the terms that stand, so the saved model is the model
+/// that was fitted. `fit_with(cfg)` fits the curve with the terms `cfg` switches on.
+pub fn fit_supported_terms<F>(
+    cfg: &FitConfig,
+    step: Option<f64>,
+    tau0_s: f64,
+    fit_with: F,
+) -> Result<NoiseFit, AllanError>
+where
+    F: Fn(&FitConfig) -> Result<NoiseFit, AllanError>,
+{
+    let mut cfg = *cfg;
+    let mut dropped: Vec<Unsupported> = Vec::new();
+    let mut fit = fit_with(&cfg)?;
+    while let Some((kind, why)) = least_supported_term(&fit, step, tau0_s) {
+        dropped.push(why);
+        let mut next = cfg;
+        match kind {
+            TermKind::Quantization => next.quantization = false,
+            TermKind::White => next.white = false,
+            TermKind::BiasInstability => next.bias_instability = false,
+            TermKind::RateRandomWalk => next.rate_random_walk = false,
+            TermKind::RateRamp => next.rate_ramp = false,
+            TermKind::GaussMarkov => next.gauss_markov = false,
+        }
+        let refit = if next.linear_terms().is_empty() && !next.gauss_markov {
+            None
+        } else {
+            fit_with(&next).ok()
         };
-        if let Some(t) = *slot
-            && t.lo <= 0.0
-        {
-            *slot = None;
-            fit.not_detected.push(UpperLimit {
-                term: kind,
-                upper: t.hi,
-            });
+        match refit {
+            Some(f) => {
+                fit = f;
+                cfg = next;
+            }
+            None => {
+                // Nothing left to refit with: report the term and leave it out.
+                match kind {
+                    TermKind::Quantization => fit.quantization = None,
+                    TermKind::White => fit.white = None,
+                    TermKind::BiasInstability => fit.bias_instability = None,
+                    TermKind::RateRandomWalk => fit.rate_random_walk = None,
+                    TermKind::RateRamp => fit.rate_ramp = None,
+                    TermKind::GaussMarkov => fit.gauss_markov = None,
+                }
+                break;
+            }
         }
     }
-    if let Some(g) = fit.gauss_markov
-        && g.sigma.lo <= 0.0
-    {
-        fit.gauss_markov = None;
-        fit.not_detected.push(UpperLimit {
-            term: TermKind::GaussMarkov,
-            upper: g.sigma.hi,
-        });
-    }
-    if let (Some(q), Some(step)) = (fit.quantization, step) {
-        let implied = step * tau0_s / 12f64.sqrt();
-        if q.value > QUANTIZATION_RESOLUTION_FACTOR * implied {
-            fit.quantization = None;
-            fit.not_identifiable.push(NotIdentifiable {
-                term: TermKind::Quantization,
-                reason: format!(
-                    "{:.1}x what the resolution step {} implies ({} (u)·s): the short-τ rise \
-                     is not quantization (filtering, a spectral hump)",
-                    q.value / implied,
-                    fmt_num(step),
-                    fmt_num(implied)
-                ),
-            });
+    for d in dropped {
+        match d {
+            Unsupported::UpperLimit(u) => {
+                fit.not_detected.retain(|x| x.term != u.term);
+                fit.not_detected.push(u);
+            }
+            Unsupported::NotIdentifiable(n) => fit.not_identifiable.push(n),
         }
     }
+    Ok(fit)
 }
 
 /// The fit range, χ²_red and its verdict, as printed under each channel.
@@ -574,11 +729,25 @@ pub fn fit_quality_lines(fit: &NoiseFit) -> String {
         let how = match r.source {
             RangeSource::Full => "the whole curve".to_string(),
             RangeSource::User => "set by --fit-range".to_string(),
-            RangeSource::Auto => format!(
-                "automatic: {} short-tau point(s) left out, where the sensor's own filtering \
-                 colours the noise and the model does not apply",
-                r.excluded_short
-            ),
+            RangeSource::Auto => {
+                let mut why = Vec::new();
+                if r.excluded_short > 0 {
+                    why.push(format!(
+                        "{} short-tau point(s) left out, where the sensor's own filtering \
+                         colours the noise and the model does not apply",
+                        r.excluded_short
+                    ));
+                }
+                if r.excluded_long > 0 {
+                    why.push(format!(
+                        "{} long-tau point(s) left out, known to worse than {:.0} % (too few \
+                         averages to hold a model to)",
+                        r.excluded_long,
+                        100.0 * CURVE_PRECISION
+                    ));
+                }
+                format!("automatic: {}", why.join("; "))
+            }
         };
         s.push_str(&format!(
             "  fit range {} … {} s ({} points; {how})\n",
@@ -652,10 +821,10 @@ impl NoiseModel {
     ///   tenth of the record ([`fit_noise_with_edf_opts`]); one at a bound is reported
     ///   not identifiable;
     /// * a term whose confidence interval reaches zero becomes an upper limit
-    ///   ([`NoiseFit::not_detected`]), not a value;
-    /// * a quantization above three times Δτ0/√12 — what angle increments quantized at the
-    ///   rate resolution step Δ (`opts.resolution`) would give (IEEE Std 952-1997 C.1) —
-    ///   is reported not identifiable and dropped.
+    ///   ([`NoiseFit::not_detected`]), not a value, and a quantization the resolution
+    ///   step (`opts.resolution`) cannot explain is reported not identifiable; either is
+    ///   dropped and the rest refitted ([`fit_supported_terms`]), so the model describes
+    ///   the curve with the terms that stand.
     pub fn from_curves_with(
         source: &str,
         curves: &[ChannelResult],
@@ -688,16 +857,37 @@ impl NoiseModel {
                 record_s: Some(samples as f64 * c.tau0_s),
                 model_error_floor: opts.model_error_floor,
             };
-            let fit_over = |i0: usize, i1: usize| {
-                fit_noise_with_edf_opts(
-                    &tau[i0..i1],
-                    &avar[i0..i1],
-                    |i, a| c.edf_for_alpha(i0 + i, a),
-                    cfg,
-                    confidence,
-                    &fit_opts,
-                )
+            let step = opts.resolution.get(k).copied().flatten();
+            let fit_with = |i0: usize, i1: usize, cfg: &FitConfig| {
+                if i0 >= i1 || i1 > tau.len() {
+                    return Err(AllanError::Invalid(format!(
+                        "no curve point between τ index {i0} and {i1}"
+                    )));
+                }
+                fit_supported_terms(cfg, step, c.tau0_s, |cfg| {
+                    fit_noise_with_edf_opts(
+                        &tau[i0..i1],
+                        &avar[i0..i1],
+                        |i, a| c.edf_for_alpha(i0 + i, a),
+                        cfg,
+                        confidence,
+                        &fit_opts,
+                    )
+                })
             };
+            let fit_over = |i0: usize, i1: usize| fit_with(i0, i1, cfg);
+            // The start is searched with the linear terms only: it is decided by the
+            // short τ, and a Gauss-Markov search per candidate would cost tens of times
+            // the rest of the fit.
+            let search_cfg = if cfg.linear_terms().is_empty() {
+                *cfg
+            } else {
+                FitConfig {
+                    gauss_markov: false,
+                    ..*cfg
+                }
+            };
+            let search_over = |i0: usize, i1: usize| fit_with(i0, i1, &search_cfg);
             let named = |e: AllanError, user: bool| {
                 AllanError::Invalid(format!(
                     "noise fit of channel '{}': {e}{}",
@@ -709,7 +899,9 @@ impl NoiseModel {
                     }
                 ))
             };
-            let n = tau.len();
+            let n = opts
+                .curve_precision
+                .map_or(tau.len(), |p| auto_fit_end(c, p));
             let (i0, i1, source, mut fit) = match opts.fit_range {
                 Some(r) => {
                     let (i0, i1) = user_indices(c, r)?;
@@ -722,31 +914,57 @@ impl NoiseModel {
                         .iter()
                         .max()
                         .map_or(0, |n| n.saturating_sub(1));
-                    if short_tau_coloured(&c.rate_acf1, longest) {
-                        let m: Vec<usize> = c.points.iter().map(|p| p.m).collect();
-                        // Mean squared normalised residual over the first half decade
-                        // of the range, with the fit's own weights.
-                        let head = |i0: usize, f: &NoiseFit| -> f64 {
-                            let (mut sum, mut k) = (0.0, 0usize);
-                            for i in (i0..n).take_while(|&i| tau[i] <= 3.0 * tau[i0]) {
-                                let model = f.model_avar(tau[i]);
-                                let nu = c.edf_for_alpha(i, f.dominant_alpha(tau[i]));
-                                if model > 0.0 && nu > 0.0 {
-                                    let var =
-                                        model * model * (2.0 / nu + opts.model_error_floor.powi(2));
-                                    sum += (avar[i] - model).powi(2) / var;
-                                    k += 1;
-                                }
+                    let coloured = short_tau_coloured(&c.rate_acf1, longest);
+                    let m: Vec<usize> = c.points.iter().map(|p| p.m).collect();
+                    // Mean squared normalised residual over points `idx`, with the
+                    // fit's own weights.
+                    let msr = |idx: &mut dyn Iterator<Item = usize>, f: &NoiseFit| -> f64 {
+                        let (mut sum, mut k) = (0.0, 0usize);
+                        for i in idx {
+                            let model = f.model_avar(tau[i]);
+                            let nu = c.edf_for_alpha(i, f.dominant_alpha(tau[i]));
+                            if model > 0.0 && nu > 0.0 {
+                                let var =
+                                    model * model * (2.0 / nu + opts.model_error_floor.powi(2));
+                                sum += (avar[i] - model).powi(2) / var;
+                                k += 1;
                             }
-                            if k == 0 { 0.0 } else { sum / k as f64 }
+                        }
+                        if k == 0 { 0.0 } else { sum / k as f64 }
+                    };
+                    // The first half decade of the range, where a filter's leftover shows.
+                    let head = |i0: usize, f: &NoiseFit| {
+                        msr(&mut (i0..n).take_while(|&i| tau[i] <= 3.0 * tau[i0]), f)
+                    };
+                    if coloured {
+                        let candidates: Vec<usize> = auto_range_candidates(&m)
+                            .into_iter()
+                            .filter(|&i0| i0 < n)
+                            .collect();
+                        let (i0, i1, src, found) = auto_range(&candidates, n, &search_over, &head)
+                            .map_err(|e| named(e, false))?;
+                        let mut f = if search_cfg == *cfg {
+                            found.clone()
+                        } else {
+                            fit_over(i0, i1).map_err(|e| named(e, false))?
                         };
-                        auto_range(&auto_range_candidates(&m), n, &fit_over, &head)
-                            .map_err(|e| named(e, false))?
+                        // The leftover of the sensor's filtering at the chosen start.
+                        if let Some(&next) = candidates.iter().find(|&&j| j > i0 && j + 1 < i1)
+                            && let Ok(later) = search_over(next, i1)
+                        {
+                            widen_for_the_start(&mut f, &found, &later, tau[next] / tau[i0]);
+                        }
+                        (i0, i1, src, f)
                     } else {
                         let f = fit_over(0, n).map_err(|e| named(e, false))?;
                         (0, n, RangeSource::Full, f)
                     }
                 }
+            };
+            let source = if source == RangeSource::Full && i1 < tau.len() {
+                RangeSource::Auto
+            } else {
+                source
             };
             fit.fit_range = Some(FitRange {
                 tau_min_s: tau[i0],
@@ -755,11 +973,6 @@ impl NoiseModel {
                 excluded_short: i0,
                 excluded_long: tau.len() - i1,
             });
-            keep_physical_terms(
-                &mut fit,
-                opts.resolution.get(k).copied().flatten(),
-                c.tau0_s,
-            );
             let mut ch = ChannelNoise::new(&c.name, q, fit, 1.0 / c.tau0_s);
             if ch.fit.bias_instability.is_some() && ch.discrete.bias_instability_gm.is_none() {
                 ch.fit.not_identifiable.push(NotIdentifiable {
@@ -1065,6 +1278,98 @@ mod tests {
     }
 
     #[test]
+    fn a_short_coloured_record_is_fitted_or_refused_without_a_panic() {
+        use crate::allan::analysis::{AnalysisConfig, analyse};
+        // AR(1) samples (lag-1 autocorrelation 0.6): coloured at the shortest τ, and so
+        // short that the curve is precise to 10 % only over its first few points, before
+        // some of the candidate starts.
+        for len in [300usize, 1_000, 3_000] {
+            let mut state = 7u64;
+            let mut e = move || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            };
+            let mut x = 0.0;
+            let y: Vec<f64> = (0..len)
+                .map(|_| {
+                    x = 0.6 * x + e();
+                    x
+                })
+                .collect();
+            let c = analyse("g", &y, 0.01, &AnalysisConfig::default()).expect("curve");
+            let r = NoiseModel::from_curves_with(
+                "short",
+                &[c],
+                &[Quantity::AngularRate],
+                &FitConfig::default(),
+                0.683,
+                &ModelOptions::default(),
+            );
+            if let Ok(m) = r {
+                let f = &m.channels[0].fit;
+                let range = f.fit_range.expect("range");
+                assert!(range.tau_min_s < range.tau_max_s, "{len}: {range:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn eliminated_terms_are_refitted_so_the_model_is_the_fitted_one() {
+        use crate::allan::fit::fit_noise_opts;
+        // N + B curve with a weak K and a deterministic ±3 % ripple; few EDF so the
+        // weak terms cannot be resolved.
+        let (n, b, kk) = (1e-3, 1e-4, 2e-7);
+        let tau: Vec<f64> = (0..60).map(|i| 0.1 * 1.15f64.powi(i)).collect();
+        let avar: Vec<f64> = tau
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| {
+                (n * n / t + BIAS_AVAR_COEF * b * b + kk * kk * t / 3.0)
+                    * (1.0 + 0.03 * (i as f64 * 1.7).sin())
+            })
+            .collect();
+        let edf: Vec<f64> = tau.iter().map(|&t| (2e4 / t).clamp(2.0, 1e5)).collect();
+        let fit_with =
+            |cfg: &FitConfig| fit_noise_opts(&tau, &avar, &edf, cfg, 0.683, &FitOptions::default());
+        let all = FitConfig::default();
+        let fit = fit_supported_terms(&all, None, 0.01, fit_with).expect("fit");
+        // Every term that stands is resolved from zero …
+        for k in [
+            TermKind::Quantization,
+            TermKind::White,
+            TermKind::BiasInstability,
+            TermKind::RateRandomWalk,
+            TermKind::RateRamp,
+        ] {
+            if let Some(t) = fit.term(k) {
+                assert!(t.lo > 0.0, "{k:?} {t:?}");
+            }
+        }
+        assert!(
+            fit.white.is_some() && fit.bias_instability.is_some(),
+            "{fit:?}"
+        );
+        // … something was eliminated …
+        assert!(!fit.not_detected.is_empty(), "{fit:?}");
+        // … and the curve is the one a direct fit with the standing terms gives.
+        let standing = FitConfig {
+            quantization: fit.quantization.is_some(),
+            white: true,
+            bias_instability: true,
+            rate_random_walk: fit.rate_random_walk.is_some(),
+            rate_ramp: fit.rate_ramp.is_some(),
+            gauss_markov: false,
+        };
+        let direct = fit_with(&standing).expect("direct");
+        for &t in &tau {
+            assert!((fit.model_avar(t) / direct.model_avar(t) - 1.0).abs() < 1e-12);
+        }
+        assert_eq!(fit.chi2_reduced, direct.chi2_reduced);
+    }
+
+    #[test]
     fn unresolved_terms_become_upper_limits_and_quantization_is_checked() {
         let mut fit = gyro_fit();
         fit.rate_random_walk = Some(Term {
@@ -1077,32 +1382,31 @@ mod tests {
             lo: 5e-6,
             hi: 2e-5,
         });
-        // Step 1e-3 at 100 Hz: Δτ0/√12 = 2.9e-6 < 1e-5/3.
-        keep_physical_terms(&mut fit, Some(1e-3), 0.01);
-        assert!(fit.rate_random_walk.is_none());
-        let k = fit
-            .not_detected
-            .iter()
-            .find(|u| u.term == TermKind::RateRandomWalk)
-            .expect("upper limit");
-        assert_eq!(k.upper, 3e-6);
-        assert!(fit.quantization.is_none());
-        let q = &fit.not_identifiable[0];
-        assert_eq!(q.term, TermKind::Quantization);
+        // Step 1e-3 at 100 Hz: Δτ0/√12 = 2.9e-6 < 1e-5/3: the quantization goes first.
+        let (kind, why) = least_supported_term(&fit, Some(1e-3), 0.01).expect("a term");
+        assert_eq!(kind, TermKind::Quantization);
+        let Unsupported::NotIdentifiable(q) = why else {
+            panic!("{why:?}")
+        };
         assert!(q.reason.contains("3.5x"), "{q:?}");
-        // A quantization the step explains stays; no step known: no check.
+        // Without a step, the unresolved K is next, as an upper limit.
+        let (kind, why) = least_supported_term(&fit, None, 0.01).expect("a term");
+        assert_eq!(kind, TermKind::RateRandomWalk);
+        assert_eq!(
+            why,
+            Unsupported::UpperLimit(UpperLimit {
+                term: TermKind::RateRandomWalk,
+                upper: 3e-6
+            })
+        );
+        // A quantization the step explains stays.
         let mut ok = gyro_fit();
         ok.quantization = Some(Term {
             value: 5e-6,
             lo: 4e-6,
             hi: 6e-6,
         });
-        keep_physical_terms(&mut ok, Some(1e-3), 0.01);
-        assert!(ok.quantization.is_some() && ok.not_identifiable.is_empty());
-        let mut unknown = fit.clone();
-        unknown.quantization = ok.quantization.map(|t| Term { value: 1.0, ..t });
-        keep_physical_terms(&mut unknown, None, 0.01);
-        assert!(unknown.quantization.is_some());
+        assert_eq!(least_supported_term(&ok, Some(1e-3), 0.01), None);
         let text = fit_quality_lines(&NoiseFit {
             chi2_reduced: 12.0,
             fit_range: Some(FitRange {

@@ -471,7 +471,9 @@ pub fn analyse_static_log(log: &ImuLog) -> Result<NoiseStage, ExperimentError> {
         &log.source,
         &results,
         &quantities,
-        &FitConfig::default(),
+        // The IEEE 952 terms: the filter's bias states are their first-order stand-in,
+        // and the simulated sensors of a study carry exactly these terms.
+        &FitConfig::IEEE_952,
         cfg.confidence,
     )
     .map_err(|e| ExperimentError::stage("noise", e))?;
