@@ -30,6 +30,17 @@
 //!   an error. A first record that still parses whole (a cut that left a shorter but valid
 //!   number) cannot be told from a good one and is kept.
 //!
+//! * Binary data: the first 64 KiB are checked before anything is parsed; a NUL or other
+//!   control byte, or mostly non-UTF-8 bytes, make the input [`LogError::BinaryData`]
+//!   naming the byte offset (a bad row holding such bytes later in the input too).
+//! * Line length: a line longer than [`TextOptions::max_line_bytes`] (1 MiB) is
+//!   [`LogError::LineTooLong`] as soon as that many bytes are buffered, so memory stays
+//!   bounded whatever the input.
+//! * One sample rate: with a time column, a stretch of sustained shorter or longer
+//!   intervals than the log's (more than 5 % off over blocks of 32 intervals; single late
+//!   samples and isolated gaps do not count) is [`LogError::RateChange`], naming where and
+//!   both rates: a log at two rates is refused, never analysed at an averaged τ0.
+//!
 //! Streaming: the input is read in chunks of [`TextOptions::chunk_bytes`] (16 MiB), cut at
 //! the last line end, split into one piece per rayon thread at line ends and parsed in
 //! parallel; the pieces' columns are appended in order. Output vectors are pre-sized from the
@@ -158,6 +169,10 @@ pub struct TextOptions {
     /// Drop a truncated first or last data record with a note instead of failing (see
     /// the module docs). Off by default: every row must then be whole.
     pub drop_truncated_edges: bool,
+    /// Longest line accepted, bytes (1 MiB by default): a longer one is an error
+    /// ([`LogError::LineTooLong`]) as soon as it is seen, so a file without line ends
+    /// (binary data, a wrong file) never makes the reader buffer it whole.
+    pub max_line_bytes: usize,
 }
 
 impl Default for TextOptions {
@@ -178,6 +193,7 @@ impl Default for TextOptions {
             chunk_bytes: 16 << 20,
             week_column: None,
             drop_truncated_edges: false,
+            max_line_bytes: 1 << 20,
         }
     }
 }
@@ -333,7 +349,17 @@ impl FromStr for Delimiter {
 /// Reads a delimited text log from a file (streamed, never loaded whole).
 pub fn read_text_file(path: impl AsRef<Path>, opts: &TextOptions) -> Result<ImuLog, LogError> {
     let (file, size, name) = super::error::open_file(path.as_ref())?;
-    read_impl(file, &name, opts, Some(size))
+    read_impl(file, &name, opts, size)
+}
+
+/// [`read_text`] with the input's size when known (pre-sizes the columns).
+pub(crate) fn read_text_sized<R: Read>(
+    reader: R,
+    source: &str,
+    opts: &TextOptions,
+    size: Option<u64>,
+) -> Result<ImuLog, LogError> {
+    read_impl(reader, source, opts, size)
 }
 
 /// Reads a delimited text log from any reader; `source` names it in errors and in
@@ -471,6 +497,8 @@ struct Plan {
     week_field: Option<usize>,
     /// The time column was found by its header name (for the log's notes).
     time_detected: bool,
+    /// Longest line accepted, bytes.
+    max_line: usize,
 }
 
 enum FieldErr {
@@ -478,11 +506,14 @@ enum FieldErr {
     Empty { field: usize },
     NonFinite { field: usize, value: String },
     Ragged { found: usize },
+    TooLong,
 }
 
 struct PieceErr {
     /// 0-based line within the piece.
     line: usize,
+    /// Byte offset of the line's start within the piece.
+    byte: usize,
     /// 1-based byte column.
     col: usize,
     kind: FieldErr,
@@ -628,6 +659,14 @@ fn parse_piece(bytes: &[u8], plan: &Plan, row_guess: usize) -> Result<PieceOut, 
     while pos < bytes.len() {
         let is_data = match fast_row(bytes, pos, plan, &mut cols) {
             Some(next) => {
+                if next - pos > plan.max_line {
+                    return Err(PieceErr {
+                        line: line_no,
+                        byte: pos,
+                        col: 1,
+                        kind: FieldErr::TooLong,
+                    });
+                }
                 pos = next;
                 true
             }
@@ -637,14 +676,24 @@ fn parse_piece(bytes: &[u8], plan: &Plan, row_guess: usize) -> Result<PieceOut, 
                 }
                 let rest = &bytes[pos..];
                 let len = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+                if len > plan.max_line {
+                    return Err(PieceErr {
+                        line: line_no,
+                        byte: pos,
+                        col: 1,
+                        kind: FieldErr::TooLong,
+                    });
+                }
                 let line = &rest[..len];
                 let line = line.strip_suffix(b"\r").unwrap_or(line);
+                let line_start = pos;
                 pos += len + 1;
                 match parse_line(line, plan, &mut cols) {
                     Ok(d) => d,
                     Err((col, kind)) => {
                         return Err(PieceErr {
                             line: line_no,
+                            byte: line_start,
                             col,
                             kind,
                         });
@@ -1081,6 +1130,7 @@ fn make_plan(
         header_line: has_header.then_some(line_no),
         week_field,
         time_detected: detected.is_some(),
+        max_line: opts.max_line_bytes,
     };
     // The first data row: whole, dropped as a cut record, or an error citing a good row.
     let k = usize::from(has_header);
@@ -1199,6 +1249,8 @@ fn read_impl<R: Read>(
     // whether it ends with the end mark; whether the input read so far does.
     let mut declared: Option<(usize, bool)> = None;
     let mut ends_marked = false;
+    // Bytes of the input before buf[0].
+    let mut consumed = 0u64;
     loop {
         while filled < buf.len() && !eof {
             match reader.read(&mut buf[filled..]) {
@@ -1208,11 +1260,27 @@ fn read_impl<R: Read>(
                 Err(e) => return Err(io(e)),
             }
         }
+        // The input's first SNIFF_BYTES, whatever the chunk size.
+        if let Some(left) = (SNIFF_BYTES as u64).checked_sub(consumed)
+            && let Some(e) = binary_error(&buf[..filled.min(left as usize)], consumed, source)
+        {
+            return Err(e);
+        }
         let end = if eof {
             filled
         } else {
             match buf[..filled].iter().rposition(|&b| b == b'\n') {
                 Some(i) => i + 1,
+                None if filled > opts.max_line_bytes => {
+                    // A line longer than the cap: stop before buffering more of it.
+                    return Err(
+                        binary_error(&buf[..filled.min(SNIFF_BYTES)], consumed, source)
+                            .unwrap_or_else(|| LogError::LineTooLong {
+                                at: Location::line(source, line_base),
+                                limit: opts.max_line_bytes,
+                            }),
+                    );
+                }
                 None => {
                     // One line longer than the buffer: grow and read on.
                     let n = buf.len();
@@ -1236,6 +1304,16 @@ fn read_impl<R: Read>(
             let mut starts = Vec::new();
             for (i, line) in lines(region).enumerate() {
                 let this_len = line_len_with_end(region, offset);
+                if line.len() > opts.max_line_bytes {
+                    let at = consumed + offset as u64;
+                    return Err(
+                        binary_error(&line[..line.len().min(SNIFF_BYTES)], at, source)
+                            .unwrap_or_else(|| LogError::LineTooLong {
+                                at: Location::line(source, line_base + i),
+                                limit: opts.max_line_bytes,
+                            }),
+                    );
+                }
                 if !is_blank_or_comment(line) {
                     starts.push(offset);
                     sample.push(SampleLine {
@@ -1316,7 +1394,10 @@ fn read_impl<R: Read>(
                     }
                 }
             }
-            for r in results {
+            let mut piece_start = start;
+            for (r, piece) in results.into_iter().zip(&pieces) {
+                let this_start = piece_start;
+                piece_start += piece.len();
                 match r {
                     Ok(piece) => {
                         for (o, c) in out.iter_mut().zip(&piece.cols) {
@@ -1336,7 +1417,15 @@ fn read_impl<R: Read>(
                         rows_total += piece.rows;
                         line_base += piece.lines;
                     }
-                    Err(e) => return Err(piece_error(e, line_base, p, source)),
+                    Err(e) => {
+                        // A bad line holding binary data is reported as such.
+                        let line = piece.get(e.byte..).unwrap_or(&[]);
+                        let len = line.iter().position(|&b| b == b'\n').unwrap_or(line.len());
+                        let line = &line[..len.min(SNIFF_BYTES)];
+                        let at = consumed + (this_start + e.byte) as u64;
+                        return Err(binary_error(line, at, source)
+                            .unwrap_or_else(|| piece_error(e, line_base, p, source)));
+                    }
                 }
             }
             if let Some((ls, le, terminated)) = tail {
@@ -1382,7 +1471,12 @@ fn read_impl<R: Read>(
                             }
                             None => {
                                 return Err(piece_error(
-                                    PieceErr { line: 0, col, kind },
+                                    PieceErr {
+                                        line: 0,
+                                        byte: 0,
+                                        col,
+                                        kind,
+                                    },
                                     line_base,
                                     p,
                                     source,
@@ -1398,6 +1492,7 @@ fn read_impl<R: Read>(
         }
         buf.copy_within(end..filled, 0);
         filled -= end;
+        consumed += end as u64;
     }
     let Some(plan) = plan else {
         return Err(LogError::Empty {
@@ -1595,7 +1690,61 @@ fn piece_error(e: PieceErr, line_base: usize, plan: &Plan, source: &str) -> LogE
             expected: plan.nfields,
             reference_line: plan.reference_line,
         },
+        FieldErr::TooLong => LogError::LineTooLong {
+            at: Location::line(source, line_base + e.line),
+            limit: plan.max_line,
+        },
     }
+}
+
+/// Bytes at the start of a text input checked for binary data.
+const SNIFF_BYTES: usize = 64 << 10;
+
+/// Whether a byte cannot occur in a text log: a C0 control other than the white space
+/// (tab, line feed, vertical tab, form feed, carriage return), SUB (a DOS end of file) and
+/// ESC (terminal colours). NUL is the common one: every binary format is full of them.
+#[inline]
+fn is_binary_byte(b: u8) -> bool {
+    b < 0x20 && !matches!(b, b'\t' | b'\n' | 0x0b | 0x0c | b'\r' | 0x1a | 0x1b)
+}
+
+/// The first sign that `bytes` are binary data, not text: (offset, what). A byte of
+/// [`is_binary_byte`], or more than one byte in eight (and at least 16) not UTF-8 — a few
+/// Latin-1 degree signs in a header stay text.
+fn binary_evidence(bytes: &[u8]) -> Option<(usize, String)> {
+    if let Some(i) = bytes.iter().position(|&b| is_binary_byte(b)) {
+        let what = match bytes[i] {
+            0 => "a NUL byte".to_owned(),
+            b => format!("control byte 0x{b:02x}"),
+        };
+        return Some((i, what));
+    }
+    let (mut bad, mut first, mut pos) = (0usize, None, 0usize);
+    for chunk in bytes.utf8_chunks() {
+        pos += chunk.valid().len();
+        let n = chunk.invalid().len();
+        if n > 0 {
+            first.get_or_insert(pos);
+            bad += n;
+        }
+        pos += n;
+    }
+    match first {
+        Some(i) if bad >= 16 && bad * 8 > bytes.len() => Some((
+            i,
+            format!("{bad} of the first {} bytes are not UTF-8", bytes.len()),
+        )),
+        _ => None,
+    }
+}
+
+/// [`LogError::BinaryData`] when `bytes` (at byte `offset` of the input) show binary data.
+fn binary_error(bytes: &[u8], offset: u64, source: &str) -> Option<LogError> {
+    binary_evidence(bytes).map(|(i, what)| LogError::BinaryData {
+        path: source.to_owned(),
+        byte_offset: offset + i as u64,
+        what,
+    })
 }
 
 type TimeResult = (f64, Vec<Range<usize>>, Vec<TimeGap>);
@@ -1666,6 +1815,17 @@ fn time_analysis(
         }
     };
     let limit = opts.gap_factor * tau0_s;
+    if let Some(r) = rate_change(t, limit) {
+        return Err(LogError::RateChange {
+            at: Location::line(source, map.line_of(r.start)),
+            name,
+            interval_s: r.interval_s,
+            other_interval_s: r.other_interval_s,
+            end_line: map.line_of(r.end),
+            start_s: t[r.start],
+            end_s: t[r.end],
+        });
+    }
     let mut gaps = Vec::new();
     for i in 1..t.len() {
         let d = t[i] - t[i - 1];
@@ -1702,6 +1862,98 @@ fn time_analysis(
         _ => std::iter::once(0..t.len()).collect(),
     };
     Ok((tau0_s, segments, gaps))
+}
+
+/// Intervals per block of the rate-change check: enough that one late sample (±25 % of an
+/// interval) moves a block's mean by under 1 %, and that time stamps rounded to 1 ms at
+/// 800 Hz move it by under 3 %.
+const RATE_BLOCK: usize = 32;
+
+/// A block whose mean interval differs from the log's by more than this fraction is at
+/// another sample rate.
+const RATE_CHANGE_TOLERANCE: f64 = 0.05;
+
+/// A stretch of a log at another sample rate: rows `start..=end`.
+struct RateStretch {
+    start: usize,
+    end: usize,
+    interval_s: f64,
+    other_interval_s: f64,
+}
+
+/// Looks for a stretch of sustained shorter or longer intervals: the intervals are cut into
+/// blocks of [`RATE_BLOCK`]; a block's interval is the mean of those up to `gap_limit`
+/// (isolated gaps are the gap policy's business), or of all when most are longer (then the
+/// long intervals are the rate, not gaps); the log's interval is the median of the blocks'.
+/// Consecutive blocks off by more than [`RATE_CHANGE_TOLERANCE`] on the same side form the
+/// stretch, trimmed to its first and last interval on that side. Only interval statistics:
+/// no resampling, no fit.
+fn rate_change(t: &[f64], gap_limit: f64) -> Option<RateStretch> {
+    let n = t.len().saturating_sub(1);
+    let nb = n / RATE_BLOCK;
+    if nb < 2 {
+        return None;
+    }
+    // Block k covers intervals k·B .. (k+1)·B, the last one also the remainder.
+    let block = |k: usize| k * RATE_BLOCK..if k + 1 == nb { n } else { (k + 1) * RATE_BLOCK };
+    let means: Vec<f64> = (0..nb)
+        .map(|k| {
+            let r = block(k);
+            let len = r.len();
+            let (mut sum, mut count, mut all) = (0.0, 0usize, 0.0);
+            for i in r {
+                let d = t[i + 1] - t[i];
+                all += d;
+                if d <= gap_limit {
+                    sum += d;
+                    count += 1;
+                }
+            }
+            if 2 * count >= len {
+                sum / count as f64
+            } else {
+                all / len as f64
+            }
+        })
+        .collect();
+    let mut sorted = means.clone();
+    let mid = sorted.len() / 2;
+    let (_, &mut interval_s, _) = sorted.select_nth_unstable_by(mid, f64::total_cmp);
+    let side = |m: f64| {
+        let dev = m / interval_s - 1.0;
+        if dev > RATE_CHANGE_TOLERANCE {
+            1
+        } else if dev < -RATE_CHANGE_TOLERANCE {
+            -1
+        } else {
+            0
+        }
+    };
+    let first = (0..nb).find(|&k| side(means[k]) != 0)?;
+    let dir = side(means[first]);
+    let last = (first..nb)
+        .take_while(|&k| side(means[k]) == dir)
+        .last()
+        .unwrap_or(first);
+    let off = |i: usize| side(t[i + 1] - t[i]) == dir;
+    let lo = block(first).start;
+    let hi = block(last).end;
+    // The stretch's own intervals, followed past the blocks' bounds.
+    let mut start = (lo..hi).find(|&i| off(i)).unwrap_or(lo);
+    while start > 0 && off(start - 1) {
+        start -= 1;
+    }
+    let mut end = (lo..hi).rev().find(|&i| off(i)).map_or(hi, |i| i + 1);
+    while end < n && off(end) {
+        end += 1;
+    }
+    let other_interval_s = (t[end] - t[start]) / (end - start).max(1) as f64;
+    Some(RateStretch {
+        start,
+        end,
+        interval_s,
+        other_interval_s,
+    })
 }
 
 #[cfg(test)]
