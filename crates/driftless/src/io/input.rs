@@ -201,6 +201,56 @@ fn read_gzip<R: Read>(stream: R, name: &str, opts: &TextOptions) -> Result<ImuLo
     }
 }
 
+/// Bytes at the start of a text input checked for binary data.
+pub(crate) const SNIFF_BYTES: usize = 64 << 10;
+
+/// Whether a byte cannot occur in a text log: a C0 control other than the white space
+/// (tab, line feed, vertical tab, form feed, carriage return), SUB (a DOS end of file) and
+/// ESC (terminal colours). NUL is the common one: every binary format is full of them.
+#[inline]
+fn is_binary_byte(b: u8) -> bool {
+    b < 0x20 && !matches!(b, b'\t' | b'\n' | 0x0b | 0x0c | b'\r' | 0x1a | 0x1b)
+}
+
+/// The first sign that `bytes` are binary data, not text: (offset, what). A byte of
+/// [`is_binary_byte`], or more than one byte in eight (and at least 16) not UTF-8 — a few
+/// Latin-1 degree signs in a header stay text.
+fn binary_evidence(bytes: &[u8]) -> Option<(usize, String)> {
+    if let Some(i) = bytes.iter().position(|&b| is_binary_byte(b)) {
+        let what = match bytes[i] {
+            0 => "a NUL byte".to_owned(),
+            b => format!("control byte 0x{b:02x}"),
+        };
+        return Some((i, what));
+    }
+    let (mut bad, mut first, mut pos) = (0usize, None, 0usize);
+    for chunk in bytes.utf8_chunks() {
+        pos += chunk.valid().len();
+        let n = chunk.invalid().len();
+        if n > 0 {
+            first.get_or_insert(pos);
+            bad += n;
+        }
+        pos += n;
+    }
+    match first {
+        Some(i) if bad >= 16 && bad * 8 > bytes.len() => Some((
+            i,
+            format!("{bad} of the first {} bytes are not UTF-8", bytes.len()),
+        )),
+        _ => None,
+    }
+}
+
+/// [`LogError::BinaryData`] when `bytes` (at byte `offset` of the input) show binary data.
+pub(crate) fn binary_error(bytes: &[u8], offset: u64, source: &str) -> Option<LogError> {
+    binary_evidence(bytes).map(|(i, what)| LogError::BinaryData {
+        path: source.to_owned(),
+        byte_offset: offset + i as u64,
+        what,
+    })
+}
+
 /// Largest configuration or model file (TOML, YAML, JSON) read: 16 MiB. Real ones are a
 /// few KiB; the cap keeps a wrong path (a log, `/dev/zero`) from filling the memory.
 pub const MAX_CONFIG_BYTES: u64 = 16 << 20;

@@ -25,6 +25,7 @@ pub mod nav;
 mod number;
 pub mod output;
 pub mod text;
+mod timing;
 #[cfg(feature = "autopilot-logs")]
 pub mod ulog;
 pub mod units;

@@ -60,8 +60,10 @@ use rayon::prelude::*;
 
 use super::edge::{Cut, Edge, REFERENCE_SAMPLE, is_number, last_data_line, note, reference_count};
 use super::error::{Location, LogError, excerpt};
+use super::input::{SNIFF_BYTES, binary_error};
 use super::log::{Channel, ImuLog, TimeGap};
 use super::number::{parse_f64, parse_prefix};
+use super::timing::rate_change;
 use super::units::{KNOWN_UNITS, TimeUnit, Unit};
 
 /// Field separator.
@@ -1697,56 +1699,6 @@ fn piece_error(e: PieceErr, line_base: usize, plan: &Plan, source: &str) -> LogE
     }
 }
 
-/// Bytes at the start of a text input checked for binary data.
-const SNIFF_BYTES: usize = 64 << 10;
-
-/// Whether a byte cannot occur in a text log: a C0 control other than the white space
-/// (tab, line feed, vertical tab, form feed, carriage return), SUB (a DOS end of file) and
-/// ESC (terminal colours). NUL is the common one: every binary format is full of them.
-#[inline]
-fn is_binary_byte(b: u8) -> bool {
-    b < 0x20 && !matches!(b, b'\t' | b'\n' | 0x0b | 0x0c | b'\r' | 0x1a | 0x1b)
-}
-
-/// The first sign that `bytes` are binary data, not text: (offset, what). A byte of
-/// [`is_binary_byte`], or more than one byte in eight (and at least 16) not UTF-8 — a few
-/// Latin-1 degree signs in a header stay text.
-fn binary_evidence(bytes: &[u8]) -> Option<(usize, String)> {
-    if let Some(i) = bytes.iter().position(|&b| is_binary_byte(b)) {
-        let what = match bytes[i] {
-            0 => "a NUL byte".to_owned(),
-            b => format!("control byte 0x{b:02x}"),
-        };
-        return Some((i, what));
-    }
-    let (mut bad, mut first, mut pos) = (0usize, None, 0usize);
-    for chunk in bytes.utf8_chunks() {
-        pos += chunk.valid().len();
-        let n = chunk.invalid().len();
-        if n > 0 {
-            first.get_or_insert(pos);
-            bad += n;
-        }
-        pos += n;
-    }
-    match first {
-        Some(i) if bad >= 16 && bad * 8 > bytes.len() => Some((
-            i,
-            format!("{bad} of the first {} bytes are not UTF-8", bytes.len()),
-        )),
-        _ => None,
-    }
-}
-
-/// [`LogError::BinaryData`] when `bytes` (at byte `offset` of the input) show binary data.
-fn binary_error(bytes: &[u8], offset: u64, source: &str) -> Option<LogError> {
-    binary_evidence(bytes).map(|(i, what)| LogError::BinaryData {
-        path: source.to_owned(),
-        byte_offset: offset + i as u64,
-        what,
-    })
-}
-
 type TimeResult = (f64, Vec<Range<usize>>, Vec<TimeGap>);
 
 fn time_analysis(
@@ -1862,98 +1814,6 @@ fn time_analysis(
         _ => std::iter::once(0..t.len()).collect(),
     };
     Ok((tau0_s, segments, gaps))
-}
-
-/// Intervals per block of the rate-change check: enough that one late sample (±25 % of an
-/// interval) moves a block's mean by under 1 %, and that time stamps rounded to 1 ms at
-/// 800 Hz move it by under 3 %.
-const RATE_BLOCK: usize = 32;
-
-/// A block whose mean interval differs from the log's by more than this fraction is at
-/// another sample rate.
-const RATE_CHANGE_TOLERANCE: f64 = 0.05;
-
-/// A stretch of a log at another sample rate: rows `start..=end`.
-struct RateStretch {
-    start: usize,
-    end: usize,
-    interval_s: f64,
-    other_interval_s: f64,
-}
-
-/// Looks for a stretch of sustained shorter or longer intervals: the intervals are cut into
-/// blocks of [`RATE_BLOCK`]; a block's interval is the mean of those up to `gap_limit`
-/// (isolated gaps are the gap policy's business), or of all when most are longer (then the
-/// long intervals are the rate, not gaps); the log's interval is the median of the blocks'.
-/// Consecutive blocks off by more than [`RATE_CHANGE_TOLERANCE`] on the same side form the
-/// stretch, trimmed to its first and last interval on that side. Only interval statistics:
-/// no resampling, no fit.
-fn rate_change(t: &[f64], gap_limit: f64) -> Option<RateStretch> {
-    let n = t.len().saturating_sub(1);
-    let nb = n / RATE_BLOCK;
-    if nb < 2 {
-        return None;
-    }
-    // Block k covers intervals k·B .. (k+1)·B, the last one also the remainder.
-    let block = |k: usize| k * RATE_BLOCK..if k + 1 == nb { n } else { (k + 1) * RATE_BLOCK };
-    let means: Vec<f64> = (0..nb)
-        .map(|k| {
-            let r = block(k);
-            let len = r.len();
-            let (mut sum, mut count, mut all) = (0.0, 0usize, 0.0);
-            for i in r {
-                let d = t[i + 1] - t[i];
-                all += d;
-                if d <= gap_limit {
-                    sum += d;
-                    count += 1;
-                }
-            }
-            if 2 * count >= len {
-                sum / count as f64
-            } else {
-                all / len as f64
-            }
-        })
-        .collect();
-    let mut sorted = means.clone();
-    let mid = sorted.len() / 2;
-    let (_, &mut interval_s, _) = sorted.select_nth_unstable_by(mid, f64::total_cmp);
-    let side = |m: f64| {
-        let dev = m / interval_s - 1.0;
-        if dev > RATE_CHANGE_TOLERANCE {
-            1
-        } else if dev < -RATE_CHANGE_TOLERANCE {
-            -1
-        } else {
-            0
-        }
-    };
-    let first = (0..nb).find(|&k| side(means[k]) != 0)?;
-    let dir = side(means[first]);
-    let last = (first..nb)
-        .take_while(|&k| side(means[k]) == dir)
-        .last()
-        .unwrap_or(first);
-    let off = |i: usize| side(t[i + 1] - t[i]) == dir;
-    let lo = block(first).start;
-    let hi = block(last).end;
-    // The stretch's own intervals, followed past the blocks' bounds.
-    let mut start = (lo..hi).find(|&i| off(i)).unwrap_or(lo);
-    while start > 0 && off(start - 1) {
-        start -= 1;
-    }
-    let mut end = (lo..hi).rev().find(|&i| off(i)).map_or(hi, |i| i + 1);
-    while end < n && off(end) {
-        end += 1;
-    }
-    let other_interval_s = (t[end] - t[start]) / (end - start).max(1) as f64;
-    Some(RateStretch {
-        start,
-        end,
-        interval_s,
-        other_interval_s,
-    })
 }
 
 #[cfg(test)]
