@@ -451,8 +451,8 @@ fn six_segmented(
 
 /// The manifest of `--manifest` and the set temperature to calibrate.
 fn six_manifest(s: &SixArgs, path: &Path) -> Result<(ChamberManifest, f64)> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let text = driftless::io::read_config_text(path, driftless::io::MAX_CONFIG_BYTES)
+        .with_context(|| format!("reading {}", path.display()))?;
     let manifest =
         ChamberManifest::from_toml_str(&text).with_context(|| format!("{}", path.display()))?;
     let mut temps: Vec<f64> = manifest

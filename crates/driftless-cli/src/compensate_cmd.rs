@@ -33,11 +33,16 @@ pub struct CompensateArgs {
 }
 
 /// The stamp an input carries, from its source line (text: the first line, read from
-/// the first 4 KiB only; DRIFTLOG: the header's source).
+/// the first 4 KiB only, of a regular file — a pipe or FIFO, already read, cannot be opened
+/// again; DRIFTLOG: the header's source).
 fn existing_stamp(path: &Path, log: &ImuLog) -> Option<String> {
     use std::io::Read as _;
     let mut head = Vec::with_capacity(4096);
-    let first = std::fs::File::open(path)
+    let first = std::fs::metadata(path)
+        .ok()
+        .filter(std::fs::Metadata::is_file)
+        .and_then(|_| std::fs::File::open(path).ok())
+        .ok_or_else(|| std::io::Error::other("not a regular file"))
         .and_then(|f| f.take(4096).read_to_end(&mut head))
         .ok()
         .map(|_| {

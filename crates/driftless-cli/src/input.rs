@@ -3,8 +3,7 @@
 use anyhow::Result;
 use clap::Args;
 use driftless::io::{
-    ColumnSpec, Delimiter, GapPolicy, HeaderMode, ImuLog, TextOptions, TimeUnit, Unit,
-    read_log_file,
+    ColumnSpec, Delimiter, GapPolicy, HeaderMode, ImuLog, LogInput, TextOptions, TimeUnit, Unit,
 };
 use std::path::Path;
 
@@ -100,13 +99,21 @@ impl InputArgs {
 
     /// Read the log at `path`: text, binary `DRIFTLOG`, or (feature `autopilot-logs`) one
     /// IMU instance of a PX4 ULog / ArduPilot DataFlash log, chosen by the file's magic bytes.
+    /// The file is opened once and sniffed on the handle that is then read, so a pipe or
+    /// FIFO gives the same log as a regular file.
     pub fn read(&self, path: &Path) -> Result<ImuLog> {
+        self.read_input(LogInput::open(path)?)
+    }
+
+    /// [`Self::read`] of an input already opened.
+    pub fn read_input(&self, input: LogInput) -> Result<ImuLog> {
         #[cfg(feature = "autopilot-logs")]
-        if let Some(log) = read_autopilot(path, self.instance)? {
-            return Ok(log);
+        if input.is_autopilot() {
+            return read_autopilot(input, self.instance);
         }
+        let path = std::path::PathBuf::from(input.name());
         let opts = self.text_options()?;
-        let log = read_log_file(path, &opts)?;
+        let log = input.read_log(&opts)?;
         if log.is_empty() {
             anyhow::bail!("{}: no data rows", path.display());
         }
@@ -127,22 +134,12 @@ fn parse_time_unit(s: &str) -> Result<TimeUnit> {
     })
 }
 
-/// Reads one IMU instance of an autopilot log, telling on stderr what the log holds;
-/// `Ok(None)` when `path` is not an autopilot log (by its first bytes).
+/// Reads one IMU instance of an autopilot log, telling on stderr what the log holds.
 #[cfg(feature = "autopilot-logs")]
-fn read_autopilot(path: &Path, instance: u8) -> Result<Option<ImuLog>> {
-    use anyhow::Context;
-    use std::io::Read;
-    let mut head = Vec::with_capacity(8);
-    std::fs::File::open(path)
-        .and_then(|f| f.take(8).read_to_end(&mut head))
-        .with_context(|| format!("reading {}", path.display()))?;
-    if driftless::io::detect_format(&head).is_none() {
-        return Ok(None);
-    }
-    let Some(all) = driftless::io::imu_logs_from_autopilot_file(path)? else {
-        return Ok(None);
-    };
+fn read_autopilot(input: LogInput, instance: u8) -> Result<ImuLog> {
+    let path = std::path::PathBuf::from(input.name());
+    let path = path.as_path();
+    let all = input.read_autopilot()?;
     let imu_topics: Vec<String> = all
         .found
         .iter()
@@ -203,5 +200,9 @@ fn read_autopilot(path: &Path, instance: u8) -> Result<Option<ImuLog>> {
             available.join(", ")
         );
     };
-    Ok(all.imus.into_iter().nth(pos).map(|i| i.log))
+    all.imus
+        .into_iter()
+        .nth(pos)
+        .map(|i| i.log)
+        .ok_or_else(|| anyhow::anyhow!("{}: no IMU instance {instance}", path.display()))
 }

@@ -198,16 +198,11 @@ fn scatter_cell(f: &driftless::thermal::ThermalFit) -> String {
 /// the one log of a text / DRIFTLOG file. Gaps are bridged (and reported by the check)
 /// unless `--gaps` asks otherwise.
 fn read_instances(path: &std::path::Path, input: &InputArgs) -> Result<Vec<(String, ImuLog)>> {
+    let opened = driftless::io::LogInput::open(path)?;
     #[cfg(feature = "autopilot-logs")]
-    {
-        use std::io::Read;
-        let mut head = Vec::with_capacity(8);
-        std::fs::File::open(path)
-            .and_then(|f| f.take(8).read_to_end(&mut head))
-            .with_context(|| format!("reading {}", path.display()))?;
-        if driftless::io::detect_format(&head).is_some()
-            && let Some(all) = driftless::io::imu_logs_from_autopilot_file(path)?
+    if opened.is_autopilot() {
         {
+            let all = opened.read_autopilot()?;
             if all.imus.is_empty() {
                 anyhow::bail!(
                     "{}: {} log without IMU data (found: {}); nothing to check",
@@ -233,13 +228,19 @@ fn read_instances(path: &std::path::Path, input: &InputArgs) -> Result<Vec<(Stri
                 .collect());
         }
     }
+    read_one(opened, input)
+}
+
+/// The one log of a text / DRIFTLOG input, gaps bridged unless `--gaps` asks otherwise.
+fn read_one(opened: driftless::io::LogInput, input: &InputArgs) -> Result<Vec<(String, ImuLog)>> {
     let mut input = input.clone();
     input.time_column.get_or_insert_with(|| "1".into());
     if input.gaps == "error" {
         input.gaps = "bridge".into();
     }
-    let log = input.read(path)?;
-    Ok(vec![(path.display().to_string(), log)])
+    let name = opened.name().to_owned();
+    let log = input.read_input(opened)?;
+    Ok(vec![(name, log)])
 }
 
 /// Check options for a fit of `order`.
@@ -592,8 +593,8 @@ fn soak_manifest(
     log: &driftless::io::ImuLog,
 ) -> Result<(ChamberManifest, Option<serde_json::Value>)> {
     if let Some(path) = &s.manifest {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        let text = driftless::io::read_config_text(path, driftless::io::MAX_CONFIG_BYTES)
+            .with_context(|| format!("reading {}", path.display()))?;
         let manifest =
             ChamberManifest::from_toml_str(&text).with_context(|| format!("{}", path.display()))?;
         return Ok((manifest, None));

@@ -102,9 +102,17 @@ fn mutated_text_never_panics_and_errors_name_lines() {
                         LogError::NonMonotonicTime { .. }
                         | LogError::DuplicateTime { .. }
                         | LogError::TimeGap { .. }
+                        | LogError::RateChange { .. }
+                        | LogError::LineTooLong { .. }
                         | LogError::HeaderOnly { .. } => {
                             let line = a.line().unwrap_or(0);
                             assert!(line >= 1 && line <= nlines, "case {case}/{k}: {s}");
+                        }
+                        LogError::BinaryData { byte_offset, .. } => {
+                            let at = usize::try_from(*byte_offset).unwrap_or(usize::MAX);
+                            assert!(at < input.len(), "case {case}/{k}: {s}");
+                            let b = input[at];
+                            assert!(!(0x20..0x80).contains(&b), "case {case}/{k}: {s}");
                         }
                         _ => {}
                     }

@@ -1163,9 +1163,11 @@ impl NoiseModel {
 
     /// Read a model from `path`.
     pub fn load(path: &Path) -> Result<NoiseModel, NoiseModelError> {
-        let s = std::fs::read_to_string(path).map_err(|e| NoiseModelError::Read {
-            path: path.to_path_buf(),
-            source: e,
+        let s = crate::io::read_config_text(path, crate::io::MAX_CONFIG_BYTES).map_err(|e| {
+            NoiseModelError::Read {
+                path: path.to_path_buf(),
+                source: e,
+            }
         })?;
         Self::parse(&s, path)
     }

@@ -168,10 +168,13 @@ impl CalibrationFile {
     pub fn load(path: impl AsRef<Path>) -> Result<CalibrationFile, ModelFileError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| ModelFileError::Io {
-            path: name.clone(),
-            source,
-        })?;
+        let text =
+            crate::io::read_config_text(path, crate::io::MAX_CONFIG_BYTES).map_err(|source| {
+                ModelFileError::Io {
+                    path: name.clone(),
+                    source,
+                }
+            })?;
         let f: CalibrationFile = toml::from_str(&text).map_err(|e| ModelFileError::Parse {
             path: name.clone(),
             message: e.to_string(),

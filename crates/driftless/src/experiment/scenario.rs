@@ -313,9 +313,11 @@ impl ExperimentScenario {
     /// Reads and checks a scenario file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<ExperimentScenario, ExperimentError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| ExperimentError::Scenario {
-            path: path.display().to_string(),
-            message: format!("cannot read: {e}"),
+        let text = crate::io::read_config_text(path, crate::io::MAX_CONFIG_BYTES).map_err(|e| {
+            ExperimentError::Scenario {
+                path: path.display().to_string(),
+                message: format!("cannot read: {e}"),
+            }
         })?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         ExperimentScenario::from_toml_str(&text, &path.display().to_string(), base)

@@ -101,9 +101,11 @@ pub fn imu_logs_from_autopilot(
 pub fn imu_logs_from_autopilot_file(
     path: impl AsRef<std::path::Path>,
 ) -> Result<Option<AutopilotImuLogs>, LogError> {
-    let path = path.as_ref();
-    let bytes = crate::io::nav::read_file(path)?;
-    imu_logs_from_autopilot(&bytes, &path.display().to_string())
+    let input = super::input::LogInput::open(path)?;
+    if !input.is_autopilot() {
+        return Ok(None);
+    }
+    input.read_autopilot().map(Some)
 }
 
 /// Little-endian scalar types of the two formats.

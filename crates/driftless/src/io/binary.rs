@@ -190,7 +190,19 @@ fn write_impl<W: Write>(log: &ImuLog, mut w: W, dest: &str) -> Result<(), LogErr
 /// data is read.
 pub fn read_binary_file(path: impl AsRef<Path>) -> Result<ImuLog, LogError> {
     let (file, size, name) = super::error::open_file(path.as_ref())?;
-    read_impl(&file, &name, Some(size), Some(&file))
+    read_impl(&file, &name, size, Some(&file))
+}
+
+/// Reads a binary log from `reader`, positioned at the magic; `size` (a regular file's
+/// length) is checked against the header, and with `file` the columns are then read at
+/// their offsets in parallel.
+pub(crate) fn read_binary_parts<R: Read>(
+    reader: R,
+    source: &str,
+    size: Option<u64>,
+    file: Option<&std::fs::File>,
+) -> Result<ImuLog, LogError> {
+    read_impl(reader, source, size, file)
 }
 
 /// Reads a binary log from any reader; `source` names it in errors.

@@ -361,6 +361,67 @@ pub enum LogError {
         /// What is wrong.
         message: String,
     },
+    /// Text reader: the input holds binary data (a NUL or other control byte, or mostly
+    /// bytes that are not UTF-8), so it is no text log; nothing is parsed from it.
+    #[error(
+        "{path}: binary data, not a text log (byte offset {byte_offset}: {what}); if it is a \
+         driftless/ULog/DataFlash binary, it lacks the magic bytes"
+    )]
+    BinaryData {
+        /// Input display name.
+        path: String,
+        /// 0-based byte offset of the first byte that gave it away.
+        byte_offset: u64,
+        /// What was found there.
+        what: String,
+    },
+    /// Text reader: a line longer than the reader's cap (`TextOptions::max_line_bytes`);
+    /// reading stops there instead of buffering the line whole.
+    #[error(
+        "{at}: line {line} is longer than {limit_text} ({limit} bytes): binary data, or not a \
+         text log? (the lines of a text log are short; for real lines this long raise \
+         TextOptions::max_line_bytes)",
+        line = at.line.unwrap_or(0),
+        limit_text = crate::io::input::human_bytes(*limit as u64)
+    )]
+    LineTooLong {
+        /// The line.
+        at: Location,
+        /// The cap, bytes.
+        limit: usize,
+    },
+    /// The sample interval changes for a stretch of the log (shorter or longer intervals
+    /// than the median, sustained, not single late samples or isolated gaps): the log holds
+    /// two sample rates. Refused, never averaged into one τ0.
+    #[error(
+        "{at}: the sample rate changes: {main} Hz (interval {dt} s) for most of the log, but \
+         {other} Hz (interval {other_dt} s) from line {start_line} (t = {t0} s) to line \
+         {end_line} (t = {t1} s) by the time column ({name}); an analysis needs one rate: cut \
+         the log into parts of one rate each, or resample it",
+        start_line = at.line.unwrap_or(0),
+        main = crate::io::error::sig6(1.0 / *interval_s),
+        dt = crate::io::error::sig6(*interval_s),
+        other = crate::io::error::sig6(1.0 / *other_interval_s),
+        other_dt = crate::io::error::sig6(*other_interval_s),
+        t0 = crate::io::error::sig6(*start_s),
+        t1 = crate::io::error::sig6(*end_s)
+    )]
+    RateChange {
+        /// The stretch at the other rate: its first line.
+        at: Location,
+        /// Time column name.
+        name: String,
+        /// The interval of most of the log, s.
+        interval_s: f64,
+        /// The interval in the stretch, s.
+        other_interval_s: f64,
+        /// Last line of the stretch.
+        end_line: usize,
+        /// Time at the stretch's first line, s.
+        start_s: f64,
+        /// Time at the stretch's last line, s.
+        end_s: f64,
+    },
     /// Writer: the log itself is inconsistent (channel lengths differ, …).
     #[error("{at}: cannot write log: {message}")]
     InvalidLog {
@@ -376,7 +437,7 @@ impl LogError {
     pub fn location(&self) -> Option<&Location> {
         use LogError::*;
         match self {
-            Io { .. } | AtByte { .. } => None,
+            Io { .. } | AtByte { .. } | BinaryData { .. } => None,
             NonNumeric { at, .. }
             | EmptyField { at, .. }
             | NonFinite { at, .. }
@@ -384,6 +445,8 @@ impl LogError {
             | NonMonotonicTime { at, .. }
             | DuplicateTime { at, .. }
             | TimeGap { at, .. }
+            | LineTooLong { at, .. }
+            | RateChange { at, .. }
             | RateMismatch { at, .. }
             | Empty { at }
             | HeaderOnly { at }
@@ -407,7 +470,9 @@ impl LogError {
     /// The 0-based byte offset the error names, if any (binary inputs).
     pub fn byte_offset(&self) -> Option<u64> {
         match self {
-            LogError::AtByte { byte_offset, .. } => Some(*byte_offset),
+            LogError::AtByte { byte_offset, .. } | LogError::BinaryData { byte_offset, .. } => {
+                Some(*byte_offset)
+            }
             _ => None,
         }
     }
@@ -445,16 +510,19 @@ pub fn sig6(v: f64) -> String {
     }
 }
 
-/// Opens `path` for reading: (file, its size in bytes, display name); errors name the file.
-pub(crate) fn open_file(path: &std::path::Path) -> Result<(std::fs::File, u64, String), LogError> {
+/// Opens `path` for reading: (file, its size in bytes when it is a regular file — pipes,
+/// FIFOs and devices have none —, display name); errors name the file.
+pub(crate) fn open_file(
+    path: &std::path::Path,
+) -> Result<(std::fs::File, Option<u64>, String), LogError> {
     let name = path.display().to_string();
     let io = |error| LogError::Io {
         path: name.clone(),
         error,
     };
     let file = std::fs::File::open(path).map_err(io)?;
-    let size = file.metadata().map_err(io)?.len();
-    Ok((file, size, name))
+    let meta = file.metadata().map_err(io)?;
+    Ok((file, meta.is_file().then_some(meta.len()), name))
 }
 
 /// Starts writing `path` atomically ([`crate::io::output::AtomicFile`]): (file, display

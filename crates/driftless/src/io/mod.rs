@@ -8,6 +8,8 @@
 //!   ULog and ArduPilot DataFlash logs → one [`log::ImuLog`] per IMU instance.
 //! * [`units`]: unit strings → SI conversion.
 //! * [`error`]: one error type, [`LogError`], naming file, line and column.
+//! * [`input`]: an input opened once and sniffed on the handle that is then read (pipes
+//!   and FIFOs work); configuration files read under a size cap.
 //! * [`output`]: every output file, written atomically; checks of output paths against inputs.
 
 #[cfg(feature = "autopilot-logs")]
@@ -17,11 +19,13 @@ pub mod binary;
 pub mod dataflash;
 pub(crate) mod edge;
 pub mod error;
+pub mod input;
 pub mod log;
 pub mod nav;
 mod number;
 pub mod output;
 pub mod text;
+mod timing;
 #[cfg(feature = "autopilot-logs")]
 pub mod ulog;
 pub mod units;
@@ -39,6 +43,7 @@ pub use ulog::{imu_logs_from_ulog, parse_ulog};
 
 pub use binary::{read_binary, read_binary_file, write_binary, write_binary_file};
 pub use error::{Location, LogError};
+pub use input::{InputFormat, LogInput, MAX_CONFIG_BYTES, read_config_text};
 pub use log::{Channel, ImuLog, Quantity, TimeGap};
 pub use text::{
     ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, TextOptions, read_text,
@@ -72,54 +77,14 @@ pub fn resolve_data_path(p: &std::path::Path, base_dir: &std::path::Path) -> std
 /// Reads a log file, choosing the reader by content: files starting with the `DRIFTLOG`
 /// magic are read as binary logs (`opts` is then ignored), gzip files (`.gz`, by their
 /// magic bytes) are decompressed on the fly and then read the same way, anything else as
-/// delimited text.
+/// delimited text. The file is opened once and sniffed on the handle that is then read
+/// ([`LogInput`]), so a pipe, a FIFO or `/dev/stdin` gives the same log as a regular file.
 pub fn read_log_file(
     path: impl AsRef<std::path::Path>,
     opts: &TextOptions,
 ) -> Result<ImuLog, LogError> {
-    use std::io::Read;
-    let path = path.as_ref();
-    let mut magic = Vec::with_capacity(8);
-    std::fs::File::open(path)
-        .and_then(|f| f.take(8).read_to_end(&mut magic))
-        .map_err(|error| LogError::Io {
-            path: path.display().to_string(),
-            error,
-        })?;
-    if magic.starts_with(&GZIP_MAGIC) {
-        return read_gzip_file(path, opts);
-    }
-    if magic.as_slice() == binary::MAGIC {
-        read_binary_file(path)
-    } else {
-        read_text_file(path, opts)
-    }
+    LogInput::open(path)?.read_log(opts)
 }
 
 /// The first two bytes of a gzip member (RFC 1952 §2.3.1: ID1 = 31, ID2 = 139).
 pub const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
-
-/// Reads a gzip-compressed log (every member, as `gzip -dc` does), choosing the reader
-/// by the decompressed content as [`read_log_file`] does. A corrupt or truncated stream is
-/// an error naming the file, never a shorter log.
-fn read_gzip_file(path: &std::path::Path, opts: &TextOptions) -> Result<ImuLog, LogError> {
-    use std::io::Read;
-    let (file, _, name) = error::open_file(path)?;
-    let mut gz =
-        flate2::read::MultiGzDecoder::new(std::io::BufReader::with_capacity(1 << 20, file));
-    let mut head = Vec::with_capacity(8);
-    (&mut gz)
-        .take(8)
-        .read_to_end(&mut head)
-        .map_err(|error| LogError::Io {
-            path: name.clone(),
-            error,
-        })?;
-    let is_binary = head.as_slice() == binary::MAGIC;
-    let stream = std::io::Cursor::new(head).chain(gz);
-    if is_binary {
-        binary::read_binary(stream, &name)
-    } else {
-        read_text(stream, &name, opts)
-    }
-}

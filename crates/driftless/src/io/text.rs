@@ -30,6 +30,17 @@
 //!   an error. A first record that still parses whole (a cut that left a shorter but valid
 //!   number) cannot be told from a good one and is kept.
 //!
+//! * Binary data: the first 64 KiB are checked before anything is parsed; a NUL or other
+//!   control byte, or mostly non-UTF-8 bytes, make the input [`LogError::BinaryData`]
+//!   naming the byte offset (a bad row holding such bytes later in the input too).
+//! * Line length: a line longer than [`TextOptions::max_line_bytes`] (1 MiB) is
+//!   [`LogError::LineTooLong`] as soon as that many bytes are buffered, so memory stays
+//!   bounded whatever the input.
+//! * One sample rate: with a time column, a stretch of sustained shorter or longer
+//!   intervals than the log's (more than 5 % off over blocks of 32 intervals; single late
+//!   samples and isolated gaps do not count) is [`LogError::RateChange`], naming where and
+//!   both rates: a log at two rates is refused, never analysed at an averaged τ0.
+//!
 //! Streaming: the input is read in chunks of [`TextOptions::chunk_bytes`] (16 MiB), cut at
 //! the last line end, split into one piece per rayon thread at line ends and parsed in
 //! parallel; the pieces' columns are appended in order. Output vectors are pre-sized from the
@@ -49,8 +60,10 @@ use rayon::prelude::*;
 
 use super::edge::{Cut, Edge, REFERENCE_SAMPLE, is_number, last_data_line, note, reference_count};
 use super::error::{Location, LogError, excerpt};
+use super::input::{SNIFF_BYTES, binary_error};
 use super::log::{Channel, ImuLog, TimeGap};
 use super::number::{parse_f64, parse_prefix};
+use super::timing::rate_change;
 use super::units::{KNOWN_UNITS, TimeUnit, Unit};
 
 /// Field separator.
@@ -158,6 +171,10 @@ pub struct TextOptions {
     /// Drop a truncated first or last data record with a note instead of failing (see
     /// the module docs). Off by default: every row must then be whole.
     pub drop_truncated_edges: bool,
+    /// Longest line accepted, bytes (1 MiB by default): a longer one is an error
+    /// ([`LogError::LineTooLong`]) as soon as it is seen, so a file without line ends
+    /// (binary data, a wrong file) never makes the reader buffer it whole.
+    pub max_line_bytes: usize,
 }
 
 impl Default for TextOptions {
@@ -178,6 +195,7 @@ impl Default for TextOptions {
             chunk_bytes: 16 << 20,
             week_column: None,
             drop_truncated_edges: false,
+            max_line_bytes: 1 << 20,
         }
     }
 }
@@ -333,7 +351,17 @@ impl FromStr for Delimiter {
 /// Reads a delimited text log from a file (streamed, never loaded whole).
 pub fn read_text_file(path: impl AsRef<Path>, opts: &TextOptions) -> Result<ImuLog, LogError> {
     let (file, size, name) = super::error::open_file(path.as_ref())?;
-    read_impl(file, &name, opts, Some(size))
+    read_impl(file, &name, opts, size)
+}
+
+/// [`read_text`] with the input's size when known (pre-sizes the columns).
+pub(crate) fn read_text_sized<R: Read>(
+    reader: R,
+    source: &str,
+    opts: &TextOptions,
+    size: Option<u64>,
+) -> Result<ImuLog, LogError> {
+    read_impl(reader, source, opts, size)
 }
 
 /// Reads a delimited text log from any reader; `source` names it in errors and in
@@ -471,6 +499,8 @@ struct Plan {
     week_field: Option<usize>,
     /// The time column was found by its header name (for the log's notes).
     time_detected: bool,
+    /// Longest line accepted, bytes.
+    max_line: usize,
 }
 
 enum FieldErr {
@@ -478,11 +508,14 @@ enum FieldErr {
     Empty { field: usize },
     NonFinite { field: usize, value: String },
     Ragged { found: usize },
+    TooLong,
 }
 
 struct PieceErr {
     /// 0-based line within the piece.
     line: usize,
+    /// Byte offset of the line's start within the piece.
+    byte: usize,
     /// 1-based byte column.
     col: usize,
     kind: FieldErr,
@@ -628,6 +661,14 @@ fn parse_piece(bytes: &[u8], plan: &Plan, row_guess: usize) -> Result<PieceOut, 
     while pos < bytes.len() {
         let is_data = match fast_row(bytes, pos, plan, &mut cols) {
             Some(next) => {
+                if next - pos > plan.max_line {
+                    return Err(PieceErr {
+                        line: line_no,
+                        byte: pos,
+                        col: 1,
+                        kind: FieldErr::TooLong,
+                    });
+                }
                 pos = next;
                 true
             }
@@ -637,14 +678,24 @@ fn parse_piece(bytes: &[u8], plan: &Plan, row_guess: usize) -> Result<PieceOut, 
                 }
                 let rest = &bytes[pos..];
                 let len = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+                if len > plan.max_line {
+                    return Err(PieceErr {
+                        line: line_no,
+                        byte: pos,
+                        col: 1,
+                        kind: FieldErr::TooLong,
+                    });
+                }
                 let line = &rest[..len];
                 let line = line.strip_suffix(b"\r").unwrap_or(line);
+                let line_start = pos;
                 pos += len + 1;
                 match parse_line(line, plan, &mut cols) {
                     Ok(d) => d,
                     Err((col, kind)) => {
                         return Err(PieceErr {
                             line: line_no,
+                            byte: line_start,
                             col,
                             kind,
                         });
@@ -1081,6 +1132,7 @@ fn make_plan(
         header_line: has_header.then_some(line_no),
         week_field,
         time_detected: detected.is_some(),
+        max_line: opts.max_line_bytes,
     };
     // The first data row: whole, dropped as a cut record, or an error citing a good row.
     let k = usize::from(has_header);
@@ -1199,6 +1251,8 @@ fn read_impl<R: Read>(
     // whether it ends with the end mark; whether the input read so far does.
     let mut declared: Option<(usize, bool)> = None;
     let mut ends_marked = false;
+    // Bytes of the input before buf[0].
+    let mut consumed = 0u64;
     loop {
         while filled < buf.len() && !eof {
             match reader.read(&mut buf[filled..]) {
@@ -1208,11 +1262,27 @@ fn read_impl<R: Read>(
                 Err(e) => return Err(io(e)),
             }
         }
+        // The input's first SNIFF_BYTES, whatever the chunk size.
+        if let Some(left) = (SNIFF_BYTES as u64).checked_sub(consumed)
+            && let Some(e) = binary_error(&buf[..filled.min(left as usize)], consumed, source)
+        {
+            return Err(e);
+        }
         let end = if eof {
             filled
         } else {
             match buf[..filled].iter().rposition(|&b| b == b'\n') {
                 Some(i) => i + 1,
+                None if filled > opts.max_line_bytes => {
+                    // A line longer than the cap: stop before buffering more of it.
+                    return Err(
+                        binary_error(&buf[..filled.min(SNIFF_BYTES)], consumed, source)
+                            .unwrap_or_else(|| LogError::LineTooLong {
+                                at: Location::line(source, line_base),
+                                limit: opts.max_line_bytes,
+                            }),
+                    );
+                }
                 None => {
                     // One line longer than the buffer: grow and read on.
                     let n = buf.len();
@@ -1236,6 +1306,16 @@ fn read_impl<R: Read>(
             let mut starts = Vec::new();
             for (i, line) in lines(region).enumerate() {
                 let this_len = line_len_with_end(region, offset);
+                if line.len() > opts.max_line_bytes {
+                    let at = consumed + offset as u64;
+                    return Err(
+                        binary_error(&line[..line.len().min(SNIFF_BYTES)], at, source)
+                            .unwrap_or_else(|| LogError::LineTooLong {
+                                at: Location::line(source, line_base + i),
+                                limit: opts.max_line_bytes,
+                            }),
+                    );
+                }
                 if !is_blank_or_comment(line) {
                     starts.push(offset);
                     sample.push(SampleLine {
@@ -1316,7 +1396,10 @@ fn read_impl<R: Read>(
                     }
                 }
             }
-            for r in results {
+            let mut piece_start = start;
+            for (r, piece) in results.into_iter().zip(&pieces) {
+                let this_start = piece_start;
+                piece_start += piece.len();
                 match r {
                     Ok(piece) => {
                         for (o, c) in out.iter_mut().zip(&piece.cols) {
@@ -1336,7 +1419,15 @@ fn read_impl<R: Read>(
                         rows_total += piece.rows;
                         line_base += piece.lines;
                     }
-                    Err(e) => return Err(piece_error(e, line_base, p, source)),
+                    Err(e) => {
+                        // A bad line holding binary data is reported as such.
+                        let line = piece.get(e.byte..).unwrap_or(&[]);
+                        let len = line.iter().position(|&b| b == b'\n').unwrap_or(line.len());
+                        let line = &line[..len.min(SNIFF_BYTES)];
+                        let at = consumed + (this_start + e.byte) as u64;
+                        return Err(binary_error(line, at, source)
+                            .unwrap_or_else(|| piece_error(e, line_base, p, source)));
+                    }
                 }
             }
             if let Some((ls, le, terminated)) = tail {
@@ -1382,7 +1473,12 @@ fn read_impl<R: Read>(
                             }
                             None => {
                                 return Err(piece_error(
-                                    PieceErr { line: 0, col, kind },
+                                    PieceErr {
+                                        line: 0,
+                                        byte: 0,
+                                        col,
+                                        kind,
+                                    },
                                     line_base,
                                     p,
                                     source,
@@ -1398,6 +1494,7 @@ fn read_impl<R: Read>(
         }
         buf.copy_within(end..filled, 0);
         filled -= end;
+        consumed += end as u64;
     }
     let Some(plan) = plan else {
         return Err(LogError::Empty {
@@ -1595,6 +1692,10 @@ fn piece_error(e: PieceErr, line_base: usize, plan: &Plan, source: &str) -> LogE
             expected: plan.nfields,
             reference_line: plan.reference_line,
         },
+        FieldErr::TooLong => LogError::LineTooLong {
+            at: Location::line(source, line_base + e.line),
+            limit: plan.max_line,
+        },
     }
 }
 
@@ -1666,6 +1767,17 @@ fn time_analysis(
         }
     };
     let limit = opts.gap_factor * tau0_s;
+    if let Some(r) = rate_change(t, limit) {
+        return Err(LogError::RateChange {
+            at: Location::line(source, map.line_of(r.start)),
+            name,
+            interval_s: r.interval_s,
+            other_interval_s: r.other_interval_s,
+            end_line: map.line_of(r.end),
+            start_s: t[r.start],
+            end_s: t[r.end],
+        });
+    }
     let mut gaps = Vec::new();
     for i in 1..t.len() {
         let d = t[i] - t[i - 1];

@@ -255,9 +255,11 @@ impl MotionProfile {
     pub fn from_file(path: impl AsRef<Path>) -> Result<MotionProfile, SimError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SimError::Profile {
-            name: name.clone(),
-            message: e.to_string(),
+        let text = crate::io::read_config_text(path, crate::io::MAX_CONFIG_BYTES).map_err(|e| {
+            SimError::Profile {
+                name: name.clone(),
+                message: e.to_string(),
+            }
         })?;
         MotionProfile::from_toml_str(&text, &name)
     }

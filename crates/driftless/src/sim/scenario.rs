@@ -333,9 +333,11 @@ impl Scenario {
     /// Reads a scenario file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<Scenario, ScenarioError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::File {
-            path: path.display().to_string(),
-            message: e.to_string(),
+        let text = crate::io::read_config_text(path, crate::io::MAX_CONFIG_BYTES).map_err(|e| {
+            ScenarioError::File {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            }
         })?;
         let mut s = Scenario::from_toml_str(&text, &path.display().to_string())?;
         s.base_dir = path

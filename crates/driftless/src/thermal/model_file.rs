@@ -217,10 +217,13 @@ impl ThermalModelFile {
     ) -> Result<(ThermalModelFile, CompensationModel), ThermalModelError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| ThermalModelError::Io {
-            path: name.clone(),
-            source,
-        })?;
+        let text =
+            crate::io::read_config_text(path, crate::io::MAX_CONFIG_BYTES).map_err(|source| {
+                ThermalModelError::Io {
+                    path: name.clone(),
+                    source,
+                }
+            })?;
         let f: ThermalModelFile =
             toml::from_str(&text).map_err(|e| ThermalModelError::Invalid {
                 path: name.clone(),

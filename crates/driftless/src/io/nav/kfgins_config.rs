@@ -50,7 +50,6 @@ use std::path::{Path, PathBuf};
 
 use saphyr::{LoadableYamlNode, MarkedYaml, Scalar, YamlData};
 
-use super::read_file;
 use crate::io::{Location, LogError};
 
 const D2R: f64 = std::f64::consts::PI / 180.0;
@@ -293,10 +292,15 @@ impl KfGinsConfig {
     /// Reads and converts a KF-GINS YAML configuration file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<KfGinsConfig, LogError> {
         let path = path.as_ref();
-        let bytes = read_file(path)?;
         let name = path.display().to_string();
-        let text = super::as_utf8(&bytes, &name)?;
-        KfGinsConfig::from_yaml_str(text, &name)
+        let text =
+            crate::io::read_config_text(path, crate::io::MAX_CONFIG_BYTES).map_err(|error| {
+                LogError::Io {
+                    path: name.clone(),
+                    error,
+                }
+            })?;
+        KfGinsConfig::from_yaml_str(&text, &name)
     }
 
     /// Parses and converts KF-GINS YAML text; `name` is used in error messages.

@@ -93,25 +93,9 @@ pub(crate) fn read_file_parallel(path: &std::path::Path) -> Result<Vec<u8>, LogE
 /// A small text file (a configuration) read whole, refused when larger than `max_bytes`,
 /// not UTF-8 or binary (a NUL byte), with a message that says which.
 pub(crate) fn read_text_capped(path: &std::path::Path, max_bytes: u64) -> Result<String, String> {
-    use std::io::Read;
-    let f = std::fs::File::open(path).map_err(|e| format!("cannot open: {e}"))?;
-    let mut bytes = Vec::new();
-    f.take(max_bytes + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read: {e}"))?;
-    if bytes.len() as u64 > max_bytes {
-        return Err(format!(
-            "larger than {max_bytes} bytes: not a configuration file (binary data or a log?)"
-        ));
-    }
-    if bytes.contains(&0) {
-        return Err("binary data (a NUL byte), not a text configuration".into());
-    }
-    String::from_utf8(bytes).map_err(|e| {
-        format!(
-            "not UTF-8 text (first bad byte at offset {}): not a configuration file",
-            e.utf8_error().valid_up_to()
-        )
+    crate::io::read_config_text(path, max_bytes).map_err(|e| match e.kind() {
+        std::io::ErrorKind::InvalidData => e.to_string(),
+        _ => format!("cannot read: {e}"),
     })
 }
 
