@@ -232,7 +232,18 @@ pub fn run_session(
         let mut ffull = fcfg.clone();
         ffull.outages_s.clear();
         let first = run_forward(&imu.epochs, used, init, &ffull)?;
-        let excluded = excluded_from(init.nav.time_s, &[]);
+        // A gate recovery (an IMU fault, a diverged state) is no evidence about the GNSS:
+        // its fixes, from the last accepted one before it to `reconverge_s` after it,
+        // are left out like a convergence period.
+        let recoveries: Vec<OutageWindow> = first
+            .recoveries
+            .iter()
+            .map(|r| OutageWindow {
+                start_s: r.time_s - r.starved_s,
+                end_s: r.time_s,
+            })
+            .collect();
+        let excluded = excluded_from(init.nav.time_s, &recoveries);
         floors = super::gnss_floor::estimate(
             first
                 .updates

@@ -230,6 +230,13 @@ pub struct FilterConfig {
     /// an outlier and the filter never recovers. Isolated outliers (a single 50-m jump)
     /// are still rejected. `None` disables. Default 3 s.
     pub gate_recovery_s: Option<f64>,
+    /// Gate recovery by count: after this many *consecutive* rejected position fixes the
+    /// next one is applied as under `gate_recovery_s` (whichever rule fires first). With
+    /// fast GNSS (4–10 Hz) it acts before the time rule: K = 5 is 1.25 s at 4 Hz, against
+    /// 3 s; with 1-Hz fixes the time rule comes first. A consistent filter rejects five
+    /// fixes in a row with probability (1 − p_reject)⁵ ≈ 10⁻²⁰ under the default gate.
+    /// `None` disables; `Some(0)` is refused. Default 5.
+    pub gate_recovery_rejections: Option<usize>,
     /// GNSS outage windows (start, end], s: a fix at t is withheld when
     /// start < t ≤ end (the fix at `start` is used, the one at `end` is not; see
     /// [`crate::nav::outage`]).
@@ -435,6 +442,7 @@ impl FilterConfig {
             quality_scale: QualityScale::default(),
             use_gnss_velocity: false,
             gate_recovery_s: Some(3.0),
+            gate_recovery_rejections: Some(5),
             outages_s: Vec::new(),
             accept_quality: Vec::new(),
             max_gap_factor: 2.5,
@@ -509,6 +517,13 @@ impl FilterConfig {
             return Err(NavError::Config(format!(
                 "gate recovery time {r} s must be finite and > 0"
             )));
+        }
+        if self.gate_recovery_rejections == Some(0) {
+            return Err(NavError::Config(
+                "gate recovery after 0 rejected fixes would apply every fix ungated: give \
+                 K ≥ 1, or none to disable the rule"
+                    .into(),
+            ));
         }
         if !self
             .quality_scale
