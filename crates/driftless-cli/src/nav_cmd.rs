@@ -225,7 +225,7 @@ pub fn run(a: NavArgs) -> Result<()> {
         Ok(job) => job,
         Err(driftless::nav::job::NavJobError::ImuValues { error, report }) => {
             warn_imu_findings(&report, usize::MAX);
-            return Err(anyhow::Error::new(error)).context("checking the IMU values");
+            return Err(anyhow::Error::new(*error)).context("checking the IMU values");
         }
         Err(e) => return Err(e.into()),
     };

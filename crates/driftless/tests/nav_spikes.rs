@@ -20,7 +20,7 @@ use std::path::PathBuf;
 use driftless::io::nav::NavSolution;
 use driftless::nav::attitude::Euler;
 use driftless::nav::earth::ned_offset_m;
-use driftless::nav::filter::{FilterConfig, RecoveryTrigger};
+use driftless::nav::filter::{FilterConfig, Gate, RecoveryTrigger};
 use driftless::nav::imu_check::{FindingKind, ImuChannel, ImuCheckConfig, check_imu};
 use driftless::nav::mechanization::NavState;
 use driftless::nav::pipeline::ImuStream;
@@ -323,19 +323,24 @@ fn gyro_spike_mid_drive_is_recovered_from_without_repair() {
             tail < 2.0 * clean_tail + 0.1,
             "axis {axis}: last-30-s RMS {tail} m vs {clean_tail} m clean"
         );
-        // The fault does not leak into the GNSS σ floor of the second pass.
+        // The fault does not leak into the GNSS σ floor of the second pass (on this
+        // short drive the fixes left after the reset's window are too few for an
+        // estimate, so the file's σ is used: no floor; before the window was left out
+        // the spike raised it from 0.02 m to 2 m).
         let (f_clean, f_spike) = (
             clean.sigma_floors.first().map(|f| f.horizontal),
             r.sigma_floors.first().map(|f| f.horizontal),
         );
-        if let (Some(a), Some(b)) = (f_clean, f_spike) {
-            assert!(b < 2.0 * a + 0.01, "σ floor {b} m vs {a} m clean");
-        }
+        let a = f_clean.expect("a floor on the clean run");
+        assert!(
+            f_spike.is_none_or(|b| b < 2.0 * a + 0.01),
+            "σ floor {f_spike:?} m vs {a} m clean"
+        );
     }
 }
 
-/// Under the χ² gate with 4-Hz fixes the count rule fires first (5 rejected fixes in
-/// 1.25 s, before the 3-s clock).
+/// With 4-Hz fixes the count rule fires first (5 rejected fixes in 1.25 s, before the
+/// 3-s clock); with the χ² gate as well (the spike's rejections are gross).
 #[test]
 fn count_rule_fires_before_the_clock_with_fast_fixes() {
     let mut sc = scenario("city-drive.toml");
@@ -352,12 +357,17 @@ fn count_rule_fires_before_the_clock_with_fast_fixes() {
         .expect("epoch");
     let dt = imu.epochs[k].dt_s;
     imu.epochs[k].dtheta_rad[0] += 1e6 * dt;
-    let r = run_session(&imu, gnss, &drive_config(&sim)).expect("run");
-    for e in &r.run.recoveries {
-        eprintln!("  {}", e.describe());
+    let mut cfg = drive_config(&sim);
+    for gate in [Gate::default(), Gate::Chi2 { p: 0.9999 }] {
+        cfg.filter.gate = gate;
+        let r = run_session(&imu, gnss, &cfg).expect("run");
+        eprintln!("gate {gate}:");
+        for e in &r.run.recoveries {
+            eprintln!("  {}", e.describe());
+        }
+        let first = r.run.recoveries.first().expect("a recovery");
+        assert_eq!(first.trigger, RecoveryTrigger::Rejections);
+        assert_eq!(first.rejected_fixes, 5);
+        assert!(first.starved_s < 3.0 && first.reset);
     }
-    let first = r.run.recoveries.first().expect("a recovery");
-    assert_eq!(first.trigger, RecoveryTrigger::Rejections);
-    assert_eq!(first.rejected_fixes, 5);
-    assert!(first.starved_s < 3.0);
 }

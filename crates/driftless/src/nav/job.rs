@@ -49,7 +49,7 @@ pub enum NavJobError {
     #[error("{error}")]
     ImuValues {
         /// The first refused value, naming time, channel and the repair option.
-        error: crate::nav::imu_check::ImuCheckError,
+        error: Box<crate::nav::imu_check::ImuCheckError>,
         /// Every finding of the check.
         report: Box<ImuCheckReport>,
     },
@@ -388,19 +388,19 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
     let c_vb = (!opts.mounting.is_identity()).then(|| opts.mounting.c_vb());
     let mut imu_check =
         check_imu(&imu, c_vb.as_ref(), &check_cfg).map_err(|e| NavJobError::ImuValues {
-            error: e,
+            error: Box::new(e),
             report: Box::default(),
         })?;
     if c.imu.repair_spikes {
         repair_spikes(&mut imu, c_vb.as_ref(), &mut imu_check, &check_cfg).map_err(|e| {
             NavJobError::ImuValues {
-                error: e,
+                error: Box::new(e),
                 report: Box::new(imu_check.clone()),
             }
         })?;
     } else if let Some(error) = non_physical_error(&imu_check, &imu.source) {
         return Err(NavJobError::ImuValues {
-            error,
+            error: Box::new(error),
             report: Box::new(imu_check),
         });
     }

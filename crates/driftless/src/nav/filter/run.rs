@@ -28,7 +28,10 @@
 //!   [`FilterConfig::gate_recovery_rejections`] = K): the time since the last
 //!   accepted position fix is counted *outside* the outage windows only, i.e.
 //!   τ = (t_fix − t_accept) − |(t_accept, t_fix] ∩ ⋃ windows|. When τ > R, or when the K
-//!   position fixes before this one were all rejected, the fix is
+//!   position fixes before this one were all rejected grossly (also by the default robust
+//!   gate at its ceiling; see [`FilterConfig::gate_recovery_rejections`]; not after an
+//!   outage window or a gap in the fixes longer than R until a fix is accepted again:
+//!   there the drift of dead reckoning is expected and the clock alone decides), the fix is
 //!   applied with [`super::Gate::Off`] (counted in [`ForwardRun::gnss_forced`], listed
 //!   with what triggered it in [`ForwardRun::recoveries`]): a state
 //!   that every fix contradicts for R seconds of GNSS coverage has diverged (e.g. after
@@ -384,6 +387,12 @@ struct Ctx<'a> {
     f_mean_b: Option<Vec3>,
     /// Position fixes rejected since the last accepted one.
     rejected_in_row: usize,
+    /// Of those, the trailing run rejected also by the default robust gate at its
+    /// ceiling ([`FilterConfig::gate_recovery_rejections`]).
+    gross_in_row: usize,
+    /// The count rule may fire: false from a fix after an outage window or a gap in the
+    /// fixes until the next accepted fix.
+    count_armed: bool,
 }
 
 impl Ctx<'_> {
@@ -495,16 +504,28 @@ impl Ctx<'_> {
         // Recovery clock: time without an accepted position fix, outside the windows.
         let starved = self.time_outside_windows(self.last_position_accept_s, t_fix);
         let by_time = self.cfg.gate_recovery_s.is_some_and(|r| starved > r);
-        let by_count = self
-            .cfg
-            .gate_recovery_rejections
-            .is_some_and(|k| self.rejected_in_row >= k);
-        let forced = by_time || by_count;
         let after_window = self
             .cfg
             .outages_s
             .iter()
             .any(|&(_, b)| b >= self.last_fix_s && b < t_fix);
+        // The count rule is for a state that diverges while fixes keep coming; after an
+        // outage window or a gap in the fixes longer than the clock, the clock alone
+        // decides until a fix is accepted again (dead-reckoning drift is expected there).
+        if after_window
+            || self
+                .cfg
+                .gate_recovery_s
+                .is_some_and(|r| t_fix - self.last_fix_s > r)
+        {
+            self.count_armed = false;
+        }
+        let by_count = self.count_armed
+            && self
+                .cfg
+                .gate_recovery_rejections
+                .is_some_and(|k| self.gross_in_row >= k);
+        let forced = by_time || by_count;
         self.last_fix_s = t_fix;
         let llh = [gn.lat_rad[g], gn.lon_rad[g], gn.height_m[g]];
         let prev_fix =
@@ -549,11 +570,24 @@ impl Ctx<'_> {
         if o.accepted {
             self.last_position_accept_s = t_fix;
             self.rejected_in_row = 0;
+            self.gross_in_row = 0;
+            self.count_armed = true;
             if forced {
                 self.run.gnss_forced += 1;
             }
         } else {
             self.rejected_in_row += 1;
+            // Gross: rejected even by the default robust gate at its 100-σ ceiling (the
+            // same test as the configured gate when that is the default; a rejected
+            // update left the state as it was, so the trial starts from it).
+            let gross = gate == super::Gate::default() || {
+                let mut trial = f.clone();
+                trial.set_gate(super::Gate::default());
+                trial
+                    .update_position(llh, sigma, self.cfg.lever_arm_b_m)
+                    .map_or(true, |o| !o.accepted)
+            };
+            self.gross_in_row = if gross { self.gross_in_row + 1 } else { 0 };
         }
         outcomes.push(o);
         if let Some(v) = &gn.vel_ned_m_s {
@@ -735,6 +769,8 @@ pub fn run_forward_with(
         prev_fix: None,
         f_mean_b: None,
         rejected_in_row: 0,
+        gross_in_row: 0,
+        count_armed: true,
         run: ForwardRun {
             epochs: Vec::with_capacity(if keep_epochs {
                 imu.len() - start + gnss.len() + 1
