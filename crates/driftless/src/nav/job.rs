@@ -1,5 +1,7 @@
 //! One navigation job from a [`crate::nav::config`] configuration: read the IMU and GNSS
-//! files it names, build the filter and session settings, choose the outages, run
+//! files it names, check the IMU values ([`crate::nav::imu_check`]: a non-physical sample
+//! stops the job unless `imu.repair_spikes` replaces isolated ones by interpolation), build
+//! the filter and session settings, choose the outages, run
 //! [`crate::nav::session::run_session`]. The CLI's `driftless nav` is this call plus
 //! printing.
 
