@@ -6,8 +6,8 @@
 //! * exact overlapping ADEV of the six channels on `log:100` taus, with and without CIs;
 //! * the opt-in fast (reduced-overlap) OADEV.
 //!
-//! `--only nav`: the strapdown mechanization, the forward filter and the RTS smoother
-//! over 1 h at 200 Hz, and `driftless nav --kf-gins` on that hour written as KF-GINS
+//! `--only nav`: the strapdown mechanization, the IMU value checks, the forward filter
+//! and the RTS smoother over 1 h at 200 Hz, and `driftless nav --kf-gins` on that hour written as KF-GINS
 //! text, in process and as a whole process (this executable spawned, its three files
 //! written into `--dir`).
 
@@ -261,6 +261,27 @@ fn nav_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
             med,
             format!("{:.0} ns/epoch", best / n_epochs as f64 * 1e9),
         ));
+
+        // The IMU value checks of `driftless nav` (non-physical, outliers, saturation)
+        // on the same hour, as one stream.
+        {
+            use driftless::nav::imu_check::{ImuCheckConfig, check_imu};
+            use driftless::nav::pipeline::ImuStream;
+            let stream = ImuStream {
+                source: "bench".into(),
+                nominal_dt_s: dt,
+                epochs: incs.clone(),
+                ..ImuStream::default()
+            };
+            let cfg = ImuCheckConfig::default();
+            let (best, med) = time_runs(a.runs, || Ok(check_imu(&stream, None, &cfg)?))?;
+            results.push((
+                format!("IMU value check (spikes, saturation), {n_epochs} epochs"),
+                best,
+                med,
+                format!("{:.0} ns/epoch", best / n_epochs as f64 * 1e9),
+            ));
+        }
 
         // 21-state forward filter with 1 Hz position fixes (truth, 2 cm σ), then the RTS
         // smoother, on the same hour.

@@ -221,7 +221,14 @@ pub fn run(a: NavArgs) -> Result<()> {
     let mut input = a.input.clone();
     input.time_column.get_or_insert_with(|| "1".into());
     let csv = input.text_options()?;
-    let job = run_nav_job(&cfg, &csv)?;
+    let job = match run_nav_job(&cfg, &csv) {
+        Ok(job) => job,
+        Err(driftless::nav::job::NavJobError::ImuValues { error, report }) => {
+            warn_imu_findings(&report, usize::MAX);
+            return Err(anyhow::Error::new(*error)).context("checking the IMU values");
+        }
+        Err(e) => return Err(e.into()),
+    };
     let note = |m: &str| {
         if !a.quiet {
             eprintln!("note: {m}");
@@ -230,6 +237,8 @@ pub fn run(a: NavArgs) -> Result<()> {
     for n in &job.notes {
         note(n);
     }
+    // Bad IMU values are warnings even with --quiet: the result depends on them.
+    warn_imu_findings(&job.imu_check, if a.verbose { usize::MAX } else { 20 });
     let res = &job.session;
     let run = &res.run;
     if a.verbose {
@@ -287,6 +296,18 @@ pub fn run(a: NavArgs) -> Result<()> {
                 "end_vertical_m": o.end_vertical_m,
             })).collect::<Vec<_>>(),
             "mean_end_horizontal_m": mean_end,
+            "gnss_resets": run.gnss_resets,
+            "gnss_recoveries": run.recoveries.iter().map(|e| serde_json::json!({
+                "time_s": e.time_s,
+                "trigger": match e.trigger {
+                    driftless::nav::filter::RecoveryTrigger::Rejections => "rejections",
+                    driftless::nav::filter::RecoveryTrigger::Time => "time",
+                },
+                "rejected_fixes": e.rejected_fixes, "starved_s": e.starved_s,
+                "horizontal_innovation_m": e.horizontal_innovation_m,
+                "reset": e.reset, "yaw_from_course": e.yaw_from_course,
+            })).collect::<Vec<_>>(),
+            "imu_check": imu_check_json(&job.imu_check),
             "outage_selection": job.selection,
             "smoothed_outages": res.smoothed_outages.as_ref().map(|v| v.iter().map(|o| serde_json::json!({
                 "start_s": o.window.start_s, "end_s": o.window.end_s,
@@ -314,6 +335,25 @@ pub fn run(a: NavArgs) -> Result<()> {
     );
     if sc.auto_sigma_floor {
         println!("{}", floor_summary(&res.sigma_floors));
+    }
+    let ic = &job.imu_check;
+    if !ic.findings.is_empty() {
+        use driftless::nav::imu_check::FindingKind;
+        outln!(
+            "IMU values: {} non-physical, {} isolated outliers, {} saturated runs; {} replaced by interpolation{}",
+            ic.count(FindingKind::NonPhysical),
+            ic.count(FindingKind::Outlier),
+            ic.count(FindingKind::Saturated),
+            ic.repaired(),
+            if ic.repaired() > 0 {
+                " (--repair-spikes)"
+            } else {
+                ""
+            }
+        );
+    }
+    for e in &run.recoveries {
+        outln!("{}", e.describe());
     }
     if let Some((rms, n)) = res.horizontal_rms_m {
         outln!(
@@ -367,6 +407,36 @@ pub fn run(a: NavArgs) -> Result<()> {
         outln!("KF-GINS-format outputs written to {}", dir.display());
     }
     Ok(())
+}
+
+/// The IMU value findings on stderr as warnings (at most `max` lines).
+fn warn_imu_findings(report: &driftless::nav::imu_check::ImuCheckReport, max: usize) {
+    for f in report.findings.iter().take(max) {
+        eprintln!("warning: {}", f.describe());
+    }
+    if report.findings.len() > max {
+        eprintln!(
+            "warning: … {} more IMU findings (--verbose or --json lists them)",
+            report.findings.len() - max
+        );
+    }
+}
+
+/// The IMU value checks as JSON.
+fn imu_check_json(report: &driftless::nav::imu_check::ImuCheckReport) -> serde_json::Value {
+    use driftless::nav::imu_check::FindingKind;
+    serde_json::json!({
+        "epochs": report.epochs,
+        "non_physical": report.count(FindingKind::NonPhysical),
+        "outliers": report.count(FindingKind::Outlier),
+        "saturated": report.count(FindingKind::Saturated),
+        "repaired": report.repaired(),
+        "findings": report.findings.iter().map(|f| serde_json::json!({
+            "kind": f.kind.name(), "channel": f.channel.name(), "index": f.index,
+            "time_s": f.time_s, "samples": f.samples, "value_si": f.value_si,
+            "reference_si": f.reference_si, "repaired": f.repaired,
+        })).collect::<Vec<_>>(),
+    })
 }
 
 /// RTKLIB quality name of a flag.

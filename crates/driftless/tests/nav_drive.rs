@@ -239,6 +239,15 @@ fn drive_0708_from_published_values() {
         100.0 * r.gnss_rejected as f64 / total as f64,
         r.gnss_forced
     );
+    // The IMU value checks find nothing on this real drive (bumps included) and the run
+    // has no gate recovery.
+    eprintln!(
+        "  IMU value checks: {} findings in {} epochs; {} gate recoveries",
+        full.imu_check.findings.len(),
+        full.imu_check.epochs,
+        r.recoveries.len()
+    );
+    assert!(full.imu_check.findings.is_empty() && r.recoveries.is_empty());
     eprintln!(
         "  σ floor estimated from the first pass: {:?}",
         full.session

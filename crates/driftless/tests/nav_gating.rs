@@ -306,8 +306,8 @@ fn fifty_metre_jump_is_rejected_by_the_robust_gate() {
 /// One gyro sample of 1e6 rad/s about x (5000 rad in one increment: a roll jump of
 /// −82° and, through the rotation correction of the velocity increment, a velocity error
 /// of ~10⁵ m/s) wrecks the state; under the default gate the gate-recovery rule resets the
-/// navigation states after 3 s of rejected fixes, the fixes are accepted again and the run
-/// ends as good as without the spike.
+/// navigation states after five rejected fixes (1.25 s at 4 Hz, before the 3-s clock),
+/// the fixes are accepted again and the run ends as good as without the spike.
 #[test]
 fn gyro_spike_is_recovered_from() {
     let clean = walk_data();

@@ -1,5 +1,7 @@
 //! One navigation job from a [`crate::nav::config`] configuration: read the IMU and GNSS
-//! files it names, build the filter and session settings, choose the outages, run
+//! files it names, check the IMU values ([`crate::nav::imu_check`]: a non-physical sample
+//! stops the job unless `imu.repair_spikes` replaces isolated ones by interpolation), build
+//! the filter and session settings, choose the outages, run
 //! [`crate::nav::session::run_session`]. The CLI's `driftless nav` is this call plus
 //! printing.
 
@@ -12,6 +14,7 @@ use crate::io::nav::kfgins::GnssReadOptions;
 use crate::nav::config::{ConfigError, KeyError, LoadedConfig};
 use crate::nav::filter::aids::{NhcConfig, StandstillConfig};
 use crate::nav::filter::model::{FilterConfig, ImuNoise};
+use crate::nav::imu_check::{ImuCheckReport, check_imu, non_physical_error, repair_spikes};
 use crate::nav::outage::OutageSpec;
 use crate::nav::pipeline::{
     GnssOutsideImu, ImuStream, PipelineError, RateChannels, TaggedCsvOptions, imu_from_kfgins,
@@ -43,6 +46,15 @@ pub enum NavJobError {
     /// The filter or the session.
     #[error(transparent)]
     Nav(#[from] crate::nav::filter::NavError),
+    /// IMU values navigation refuses (non-physical, not repaired), with the report of
+    /// every finding.
+    #[error("{error}")]
+    ImuValues {
+        /// The first refused value, naming time, channel and the repair option.
+        error: Box<crate::nav::imu_check::ImuCheckError>,
+        /// Every finding of the check.
+        report: Box<ImuCheckReport>,
+    },
 }
 
 impl From<crate::io::LogError> for NavJobError {
@@ -82,6 +94,9 @@ pub struct NavJobResult {
     /// What the readers and the job noted (skipped records, bridged gaps, settings taken
     /// from the data).
     pub notes: Vec<String>,
+    /// The IMU value checks ([`crate::nav::imu_check`]): non-physical samples, outliers,
+    /// saturation, and which were repaired.
+    pub imu_check: ImuCheckReport,
 }
 
 fn located(cfg: &LoadedConfig, key: &str, message: String) -> NavJobError {
@@ -224,6 +239,8 @@ pub struct NavInputs {
     pub outages: OutageSpec,
     /// What the readers noted.
     pub notes: Vec<String>,
+    /// The IMU value checks and repairs.
+    pub imu_check: ImuCheckReport,
 }
 
 /// Runs the job of `cfg`: [`read_nav_inputs`], the outages, [`run_session`].
@@ -236,6 +253,7 @@ pub fn run_nav_job(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavJobResult
         mut session_config,
         outages,
         notes,
+        imu_check,
     } = read_nav_inputs(cfg, csv)?;
     let (spec, selection) = choose_outages(outages, &fixes)?;
     session_config.outages = select_gnss(&fixes, &imu, &spec, GnssOutsideImu::Drop)?.windows;
@@ -249,6 +267,7 @@ pub fn run_nav_job(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavJobResult
         session_config,
         selection,
         notes,
+        imu_check,
     })
 }
 
@@ -365,6 +384,28 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
             ));
         }
     }
+    // The IMU values, on the sensor's axes, before the calibration (module docs of
+    // `imu_check`): refused when non-physical unless repair is asked for.
+    let check_cfg = c.imu_check_config();
+    let c_vb = (!opts.mounting.is_identity()).then(|| opts.mounting.c_vb());
+    let mut imu_check =
+        check_imu(&imu, c_vb.as_ref(), &check_cfg).map_err(|e| NavJobError::ImuValues {
+            error: Box::new(e),
+            report: Box::default(),
+        })?;
+    if c.imu.repair_spikes {
+        repair_spikes(&mut imu, c_vb.as_ref(), &mut imu_check, &check_cfg).map_err(|e| {
+            NavJobError::ImuValues {
+                error: Box::new(e),
+                report: Box::new(imu_check.clone()),
+            }
+        })?;
+    } else if let Some(error) = non_physical_error(&imu_check, &imu.source) {
+        return Err(NavJobError::ImuValues {
+            error: Box::new(error),
+            report: Box::new(imu_check),
+        });
+    }
     if let Some((cal, g)) = &calibration {
         imu.apply_calibration(cal, g.as_ref());
     }
@@ -404,6 +445,7 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
         session_config,
         outages: spec,
         notes,
+        imu_check,
     })
 }
 

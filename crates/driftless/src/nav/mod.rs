@@ -8,6 +8,7 @@ pub mod config;
 pub mod earth;
 pub mod filter;
 pub mod gnss_floor;
+pub mod imu_check;
 pub mod job;
 pub mod kfgins_job;
 pub mod mechanization;

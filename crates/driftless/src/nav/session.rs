@@ -41,6 +41,9 @@
 //!   starting at the same fix as the first pass (its initial σ recomputed from the
 //!   floored fixes). The estimate describes the recording's GNSS, as a noise model
 //!   describes its IMU: withheld fixes count in it, one number per class and axis group.
+//!   Fixes around a reset of the first pass's gate recovery (from the last accepted fix
+//!   before it to [`SessionConfig::reconverge_s`] after it: an IMU fault, not the GNSS)
+//!   are left out.
 //! * **Evaluation**: the reference is the GNSS fixes themselves (on `drive_0708` an RTK
 //!   solution, cm level). The full-GNSS accuracy is the one-step prediction error at each
 //!   accepted fix — the horizontal innovation, i.e. the filter's antenna position *before*
@@ -232,7 +235,21 @@ pub fn run_session(
         let mut ffull = fcfg.clone();
         ffull.outages_s.clear();
         let first = run_forward(&imu.epochs, used, init, &ffull)?;
-        let excluded = excluded_from(init.nav.time_s, &[]);
+        // A reset by the gate recovery (an IMU fault, a state far off) is no evidence
+        // about the GNSS: its fixes, from the last accepted one before it to
+        // `reconverge_s` after it, are left out like a convergence period. (Fixes the
+        // gate rejected for a few σ and the clock then forced are kept: they are the
+        // evidence of an optimistic σ the floor is there to find.)
+        let recoveries: Vec<OutageWindow> = first
+            .recoveries
+            .iter()
+            .filter(|r| r.reset)
+            .map(|r| OutageWindow {
+                start_s: r.time_s - r.starved_s,
+                end_s: r.time_s,
+            })
+            .collect();
+        let excluded = excluded_from(init.nav.time_s, &recoveries);
         floors = super::gnss_floor::estimate(
             first
                 .updates

@@ -149,6 +149,30 @@ pub const KEYS: &[Key] = &[
         "error | bridge: an IMU interval longer than twice the nominal one stops the run, or is integrated across with a note",
         "",
     ),
+    key(
+        "imu.repair_spikes",
+        "repair-spikes",
+        "BOOL",
+        Bool,
+        "replace isolated non-physical or outlier IMU samples (one or two in a row) by interpolation of their neighbours; without it a non-physical sample stops the run",
+        "",
+    ),
+    key(
+        "imu.max_gyro_deg_s",
+        "max-gyro-deg-s",
+        "DEG_S",
+        Float,
+        "hard limit on a gyro sample, deg/s: above it a sample is non-physical (twice the widest MEMS range, ±2000 deg/s)",
+        "",
+    ),
+    key(
+        "imu.max_accel_g",
+        "max-accel-g",
+        "G",
+        Float,
+        "hard limit on an accelerometer sample, g: above it a sample is non-physical (twice the ±200 g of high-g MEMS parts)",
+        "",
+    ),
     // [gnss]
     key(
         "gnss.file",

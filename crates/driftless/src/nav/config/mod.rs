@@ -73,6 +73,14 @@ pub struct ImuSection {
     pub calibration: Option<PathBuf>,
     /// `error` or `bridge`.
     pub gaps: String,
+    /// Replace isolated non-physical or outlier samples by interpolation of their
+    /// neighbours ([`crate::nav::imu_check::repair_spikes`]) instead of refusing to
+    /// navigate through non-physical values.
+    pub repair_spikes: bool,
+    /// Hard limit on a gyro sample, °/s ([`crate::nav::imu_check::ImuCheckConfig`]).
+    pub max_gyro_deg_s: f64,
+    /// Hard limit on an accelerometer sample, g (9.806 65 m/s²).
+    pub max_accel_g: f64,
 }
 
 impl Default for ImuSection {
@@ -89,6 +97,9 @@ impl Default for ImuSection {
             misalignment_rpy_deg: [0.0; 3],
             calibration: None,
             gaps: "error".into(),
+            repair_spikes: false,
+            max_gyro_deg_s: 4000.0,
+            max_accel_g: 400.0,
         }
     }
 }
@@ -782,6 +793,14 @@ impl NavConfig {
                 format!("{:?}: error or bridge", i.gaps),
             ));
         }
+        for (k, v, unit) in [
+            ("imu.max_gyro_deg_s", i.max_gyro_deg_s, "deg/s"),
+            ("imu.max_accel_g", i.max_accel_g, "g"),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(key_err(k, format!("{v} {unit}: a limit is > 0")));
+            }
+        }
         let g = &self.gnss;
         if !g
             .lever_arm_m
@@ -930,6 +949,15 @@ impl NavConfig {
             },
             nominal_dt_s: i.rate_hz.map(|r| 1.0 / r),
             ..ImuStreamOptions::default()
+        }
+    }
+
+    /// The IMU value checks ([`crate::nav::imu_check`]) with the configured hard limits.
+    pub fn imu_check_config(&self) -> crate::nav::imu_check::ImuCheckConfig {
+        crate::nav::imu_check::ImuCheckConfig {
+            max_gyro_rad_s: self.imu.max_gyro_deg_s.to_radians(),
+            max_accel_m_s2: self.imu.max_accel_g * driftless_model::units::STANDARD_GRAVITY,
+            ..Default::default()
         }
     }
 

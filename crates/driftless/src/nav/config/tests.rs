@@ -117,6 +117,8 @@ fn every_new_key_is_validated() {
         ("imu.mounting_rpy_deg", "1000,0,0", "±360"),
         ("imu.format", "xml", "not a format"),
         ("imu.rate_hz", "0", "> 0"),
+        ("imu.max_gyro_deg_s", "0", "> 0"),
+        ("imu.max_accel_g", "-1", "> 0"),
         ("gnss.lever_arm_m", "0,0,500", "±100"),
         ("gnss.sigma_scale", "float=-3", "> 0"),
         ("gnss.accept", "fix,fixed", "not a solution quality"),

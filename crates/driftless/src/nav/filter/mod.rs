@@ -45,8 +45,8 @@ pub use model::{
     FilterConfig, GATE_CHOICES, Gate, GaussMarkov, ImuNoise, QualityScale, Transition,
 };
 pub use run::{
-    EpochRecord, ForwardRun, InitialState, RunOptions, UpdateRecord, run_forward,
-    run_forward_observed, run_forward_with,
+    EpochRecord, ForwardRun, InitialState, RecoveryEvent, RecoveryTrigger, RunOptions,
+    UpdateRecord, run_forward, run_forward_observed, run_forward_with,
 };
 pub use smoother::{SmoothedEpoch, SmoothedRun, smooth, smooth_with_covariances};
 pub use state::{N_STATES, SensorErrors};

@@ -230,6 +230,21 @@ pub struct FilterConfig {
     /// an outlier and the filter never recovers. Isolated outliers (a single 50-m jump)
     /// are still rejected. `None` disables. Default 3 s.
     pub gate_recovery_s: Option<f64>,
+    /// Gate recovery by count: after this many *consecutive* position fixes rejected
+    /// grossly — rejected by the configured gate and also by the default robust gate at
+    /// its ceiling ([`Gate::Robust`]: inconsistent even with the fix's σ inflated 100
+    /// times; under the default gate every rejection is gross) — the next one is applied
+    /// as under `gate_recovery_s` (whichever rule fires first). With fast GNSS (4–10 Hz)
+    /// it acts before the time rule: K = 5 is 1.25 s at 4 Hz, against 3 s; with 1-Hz
+    /// fixes the time rule comes first. A consistent filter rejects five fixes in a row
+    /// with probability (1 − 0.9999)⁵ = 10⁻²⁰ under the default gate; the χ² gate's
+    /// ordinary rejections (a fix a few σ off) do not count, so a run whose state never
+    /// diverges is unchanged by this rule. It is not armed after an outage window or a
+    /// gap in the fixes longer than `gate_recovery_s` until a fix is accepted (the drift
+    /// of dead reckoning is expected there; the clock decides, as before this rule).
+    /// `None` disables; `Some(0)` is refused.
+    /// Default 5.
+    pub gate_recovery_rejections: Option<usize>,
     /// GNSS outage windows (start, end], s: a fix at t is withheld when
     /// start < t ≤ end (the fix at `start` is used, the one at `end` is not; see
     /// [`crate::nav::outage`]).
@@ -435,6 +450,7 @@ impl FilterConfig {
             quality_scale: QualityScale::default(),
             use_gnss_velocity: false,
             gate_recovery_s: Some(3.0),
+            gate_recovery_rejections: Some(5),
             outages_s: Vec::new(),
             accept_quality: Vec::new(),
             max_gap_factor: 2.5,
@@ -509,6 +525,13 @@ impl FilterConfig {
             return Err(NavError::Config(format!(
                 "gate recovery time {r} s must be finite and > 0"
             )));
+        }
+        if self.gate_recovery_rejections == Some(0) {
+            return Err(NavError::Config(
+                "gate recovery after 0 rejected fixes would apply every fix ungated: give \
+                 K ≥ 1, or none to disable the rule"
+                    .into(),
+            ));
         }
         if !self
             .quality_scale

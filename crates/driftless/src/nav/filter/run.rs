@@ -24,10 +24,16 @@
 //! Every update is gated by [`FilterConfig::gate`] (the NHC by its own gate when it sets
 //! one). Two rules keep the filter from starving:
 //!
-//! * **Gate recovery** ([`FilterConfig::gate_recovery_s`] = R): the time since the last
+//! * **Gate recovery** ([`FilterConfig::gate_recovery_s`] = R,
+//!   [`FilterConfig::gate_recovery_rejections`] = K): the time since the last
 //!   accepted position fix is counted *outside* the outage windows only, i.e.
-//!   τ = (t_fix − t_accept) − |(t_accept, t_fix] ∩ ⋃ windows|. When τ > R the fix is
-//!   applied with [`super::Gate::Off`] (counted in [`ForwardRun::gnss_forced`]): a state
+//!   τ = (t_fix − t_accept) − |(t_accept, t_fix] ∩ ⋃ windows|. When τ > R, or when the K
+//!   position fixes before this one were all rejected grossly (also by the default robust
+//!   gate at its ceiling; see [`FilterConfig::gate_recovery_rejections`]; not after an
+//!   outage window or a gap in the fixes longer than R until a fix is accepted again:
+//!   there the drift of dead reckoning is expected and the clock alone decides), the fix is
+//!   applied with [`super::Gate::Off`] (counted in [`ForwardRun::gnss_forced`], listed
+//!   with what triggered it in [`ForwardRun::recoveries`]): a state
 //!   that every fix contradicts for R seconds of GNSS coverage has diverged (e.g. after
 //!   an IMU fault) and the fixes are trusted over it. When that fix is a gross outlier
 //!   even for the default robust gate at its ceiling (the state is far off, not merely
@@ -36,10 +42,13 @@
 //!   the fix (lever arm removed); velocity from the chord to the previous fix when it is
 //!   at most 2R earlier (σ the chord's, at least 1 m/s), else zero with σ 10 m/s; roll
 //!   and pitch levelled from the mean specific force of the last second (exponential
-//!   mean, time constant 1 s; σ 5°, covering accelerations up to ≈ 0.9 m/s²), yaw kept
-//!   with σ at least 10°; the sensor-error states are kept. A gyro fault about a level
-//!   body's x or y axis (a roll or pitch jump) is thus undone; a yaw jump is not
-//!   observable this way and is left to the filter.
+//!   mean, time constant 1 s; σ 5°, covering accelerations up to ≈ 0.9 m/s²); yaw kept
+//!   with σ at least 10°, unless the chord's speed is at least 1 m/s and its course
+//!   atan2(v_E, v_N) differs from the kept yaw by more than 30°: then the yaw is the
+//!   course with σ 10° (the heading a land vehicle or walker moves along, as at the
+//!   initialisation; a vehicle reversing at that moment gets the opposite heading and is
+//!   left to the filter). The sensor-error states are kept. A gyro fault about any axis
+//!   (a roll, pitch or yaw jump) is thus undone.
 //! * **First fix after an outage window**: under [`super::Gate::Robust`] it is applied
 //!   with the robust weight but never rejected ([`super::Gate::never_reject`]), so an
 //!   outage is never lengthened by rejected fixes because the window was long. Under
@@ -85,6 +94,13 @@ use crate::nav::mechanization::{ImuIncrement, NavState};
 
 /// Time tolerance for "the fix is at this epoch", s.
 const EPS_T: f64 = 1e-6;
+
+/// Smallest chord speed whose course can replace the yaw at a reset, m/s (module docs).
+const RESET_COURSE_MIN_SPEED_M_S: f64 = 1.0;
+
+/// Largest difference between the kept yaw and the course at a reset before the course
+/// replaces it, rad (30°; module docs).
+const RESET_COURSE_MAX_DIFF_RAD: f64 = std::f64::consts::PI / 6.0;
 
 /// Initial state of a forward run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -155,6 +171,65 @@ pub struct UpdateRecord {
     pub p_post: Box<PackedCov>,
 }
 
+/// What made a position fix bypass the gate (module docs, gate recovery).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RecoveryTrigger {
+    /// [`FilterConfig::gate_recovery_rejections`] consecutive fixes rejected.
+    Rejections,
+    /// No fix accepted for longer than [`FilterConfig::gate_recovery_s`] (outside the
+    /// outage windows).
+    Time,
+}
+
+/// One gate recovery: a position fix applied without the gate after the filter had
+/// rejected the fixes before it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RecoveryEvent {
+    /// Time of the fix, s.
+    pub time_s: f64,
+    /// What triggered it.
+    pub trigger: RecoveryTrigger,
+    /// Position fixes rejected in a row before it.
+    pub rejected_fixes: usize,
+    /// Time since the last accepted position fix, outside the outage windows, s.
+    pub starved_s: f64,
+    /// Horizontal distance between the predicted antenna position and the fix, m.
+    pub horizontal_innovation_m: f64,
+    /// The navigation states were re-initialised at the fix (the state was far off,
+    /// not merely over-confident).
+    pub reset: bool,
+    /// At the reset the yaw was taken from the GNSS course (module docs).
+    pub yaw_from_course: bool,
+}
+
+impl RecoveryEvent {
+    /// One line: time, trigger, what was done.
+    pub fn describe(&self) -> String {
+        let what = if self.reset {
+            format!(
+                "navigation state reset to the fix (position, velocity from the fixes, tilt \
+                 levelled, {})",
+                if self.yaw_from_course {
+                    "yaw from the GNSS course"
+                } else {
+                    "yaw kept"
+                }
+            )
+        } else {
+            "the fix applied without the gate".to_string()
+        };
+        let why = match self.trigger {
+            RecoveryTrigger::Rejections => "consecutive rejections",
+            RecoveryTrigger::Time => "time without an accepted fix",
+        };
+        format!(
+            "gate recovery at t = {:.3} s after {} rejected fixes in {:.1} s ({why}); \
+             predicted position {:.1} m from the fix; {what}",
+            self.time_s, self.rejected_fixes, self.starved_s, self.horizontal_innovation_m
+        )
+    }
+}
+
 /// Result of [`run_forward`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct ForwardRun {
@@ -181,6 +256,11 @@ pub struct ForwardRun {
     /// Forced fixes before which the navigation states were re-initialised (module docs;
     /// a subset of `gnss_forced`).
     pub gnss_resets: usize,
+    /// Every gate recovery after rejected fixes or with a reset, in time order (module
+    /// docs): what triggered it and whether the state was reset. Empty on a run whose
+    /// fixes the gate never rejected in a row. (A fix forced only because the GNSS data
+    /// had a gap longer than the clock is counted in `gnss_forced`, not listed.)
+    pub recoveries: Vec<RecoveryEvent>,
     /// Measurements accepted.
     pub gnss_accepted: usize,
     /// NHC updates accepted ([`super::aids`]).
@@ -305,6 +385,14 @@ struct Ctx<'a> {
     prev_fix: Option<(f64, (f64, f64, f64), f64)>,
     /// Exponential mean (time constant 1 s) of the raw specific force, body, m/s².
     f_mean_b: Option<Vec3>,
+    /// Position fixes rejected since the last accepted one.
+    rejected_in_row: usize,
+    /// Of those, the trailing run rejected also by the default robust gate at its
+    /// ceiling ([`FilterConfig::gate_recovery_rejections`]).
+    gross_in_row: usize,
+    /// The count rule may fire: false from a fix after an outage window or a gap in the
+    /// fixes until the next accepted fix.
+    count_armed: bool,
 }
 
 impl Ctx<'_> {
@@ -340,16 +428,39 @@ impl Ctx<'_> {
         (t1 - t0 - inside).max(0.0)
     }
 
-    /// Re-initialise the navigation states at the fix `llh` (module docs, gate recovery).
+    /// Re-initialise the navigation states at the fix `llh` (module docs, gate recovery);
+    /// true when the yaw was taken from the course.
     fn reset_to_fix(
         &self,
         f: &mut Eskf,
         llh: [f64; 3],
         sigma: Vec3,
         prev_fix: Option<(f64, (f64, f64, f64), f64)>,
-    ) -> Result<(), NavError> {
+    ) -> Result<bool, NavError> {
         let t = f.nav().time_s;
-        let yaw = Euler::from_dcm(&f.nav().q_bn.to_dcm()).yaw_rad;
+        let kept_yaw = Euler::from_dcm(&f.nav().q_bn.to_dcm()).yaw_rad;
+        let max_chord_s = 2.0 * self.cfg.gate_recovery_s.unwrap_or(0.0);
+        let chord = match prev_fix {
+            Some((tp, p, sp)) if t - tp > 0.0 && t - tp <= max_chord_s => {
+                let d = earth::ned_offset_m(p, (llh[0], llh[1], llh[2]));
+                let dt = t - tp;
+                Some((
+                    d.map(|x| x / dt),
+                    (sp.hypot(sigma[0].max(sigma[1])) / dt).max(1.0),
+                ))
+            }
+            _ => None,
+        };
+        // Yaw from the course when the chord moves and the kept yaw is far from it.
+        let course = chord
+            .filter(|(v, _)| v[0].hypot(v[1]) >= RESET_COURSE_MIN_SPEED_M_S)
+            .map(|(v, _)| v[1].atan2(v[0]))
+            .filter(|c| {
+                let d = (kept_yaw - c + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                    - std::f64::consts::PI;
+                d.abs() > RESET_COURSE_MAX_DIFF_RAD
+            });
+        let yaw = course.unwrap_or(kept_yaw);
         let (roll, pitch) = match self.f_mean_b {
             Some(fm) if norm(fm) > 1.0 => ((-fm[1]).atan2(-fm[2]), fm[0].atan2(fm[1].hypot(fm[2]))),
             _ => (0.0, 0.0),
@@ -363,18 +474,7 @@ impl Ctx<'_> {
         let l_n = q_bn.rotate(self.cfg.lever_arm_b_m);
         let rm = earth::meridian_radius_m(llh[0]) + llh[2];
         let rn = earth::prime_vertical_radius_m(llh[0]) + llh[2];
-        let max_chord_s = 2.0 * self.cfg.gate_recovery_s.unwrap_or(0.0);
-        let (vel, sigma_v) = match prev_fix {
-            Some((tp, p, sp)) if t - tp > 0.0 && t - tp <= max_chord_s => {
-                let d = earth::ned_offset_m(p, (llh[0], llh[1], llh[2]));
-                let dt = t - tp;
-                (
-                    d.map(|x| x / dt),
-                    (sp.hypot(sigma[0].max(sigma[1])) / dt).max(1.0),
-                )
-            }
-            _ => ([0.0; 3], 10.0),
-        };
+        let (vel, sigma_v) = chord.unwrap_or(([0.0; 3], 10.0));
         let nav = NavState {
             time_s: t,
             lat_rad: llh[0] - l_n[0] / rm,
@@ -383,9 +483,14 @@ impl Ctx<'_> {
             vel_ned_m_s: vel,
             q_bn,
         };
-        let sigma_yaw = f.std()[ATT + 2].max(10f64.to_radians());
+        let sigma_yaw = if course.is_some() {
+            10f64.to_radians()
+        } else {
+            f.std()[ATT + 2].max(10f64.to_radians())
+        };
         let tilt = 5f64.to_radians();
-        f.reset_navigation(nav, sigma, [sigma_v; 3], [tilt, tilt, sigma_yaw])
+        f.reset_navigation(nav, sigma, [sigma_v; 3], [tilt, tilt, sigma_yaw])?;
+        Ok(course.is_some())
     }
 
     /// Apply fix `g` at the current filter epoch and refresh the last record.
@@ -398,12 +503,29 @@ impl Ctx<'_> {
         let t_fix = gn.time_s[g];
         // Recovery clock: time without an accepted position fix, outside the windows.
         let starved = self.time_outside_windows(self.last_position_accept_s, t_fix);
-        let forced = self.cfg.gate_recovery_s.is_some_and(|r| starved > r);
+        let by_time = self.cfg.gate_recovery_s.is_some_and(|r| starved > r);
         let after_window = self
             .cfg
             .outages_s
             .iter()
             .any(|&(_, b)| b >= self.last_fix_s && b < t_fix);
+        // The count rule is for a state that diverges while fixes keep coming; after an
+        // outage window or a gap in the fixes longer than the clock, the clock alone
+        // decides until a fix is accepted again (dead-reckoning drift is expected there).
+        if after_window
+            || self
+                .cfg
+                .gate_recovery_s
+                .is_some_and(|r| t_fix - self.last_fix_s > r)
+        {
+            self.count_armed = false;
+        }
+        let by_count = self.count_armed
+            && self
+                .cfg
+                .gate_recovery_rejections
+                .is_some_and(|k| self.gross_in_row >= k);
+        let forced = by_time || by_count;
         self.last_fix_s = t_fix;
         let llh = [gn.lat_rad[g], gn.lon_rad[g], gn.height_m[g]];
         let prev_fix =
@@ -413,12 +535,30 @@ impl Ctx<'_> {
         if forced {
             let mut trial = f.clone();
             trial.set_gate(super::Gate::default());
-            let gross = trial
-                .update_position(llh, sigma, self.cfg.lever_arm_b_m)
-                .map_or(true, |o| !o.accepted);
+            let o = trial.update_position(llh, sigma, self.cfg.lever_arm_b_m);
+            let gross = o.as_ref().map_or(true, |o| !o.accepted);
+            let innovation = o.map_or(f64::NAN, |o| o.innovation[0].hypot(o.innovation[1]));
+            let mut yaw_from_course = false;
             if gross {
-                self.reset_to_fix(f, llh, sigma, prev_fix)?;
+                yaw_from_course = self.reset_to_fix(f, llh, sigma, prev_fix)?;
                 self.run.gnss_resets += 1;
+            }
+            // A fix forced after a gap in the GNSS data, with nothing rejected and no
+            // reset, is the clock at work, not a recovery: counted in `gnss_forced` only.
+            if self.rejected_in_row > 0 || gross {
+                self.run.recoveries.push(RecoveryEvent {
+                    time_s: t_fix,
+                    trigger: if by_time {
+                        RecoveryTrigger::Time
+                    } else {
+                        RecoveryTrigger::Rejections
+                    },
+                    rejected_fixes: self.rejected_in_row,
+                    starved_s: starved,
+                    horizontal_innovation_m: innovation,
+                    reset: gross,
+                    yaw_from_course,
+                });
             }
             f.set_gate(super::Gate::Off);
         } else if after_window && matches!(gate, super::Gate::Robust { .. }) {
@@ -429,9 +569,25 @@ impl Ctx<'_> {
         let o = o?;
         if o.accepted {
             self.last_position_accept_s = t_fix;
+            self.rejected_in_row = 0;
+            self.gross_in_row = 0;
+            self.count_armed = true;
             if forced {
                 self.run.gnss_forced += 1;
             }
+        } else {
+            self.rejected_in_row += 1;
+            // Gross: rejected even by the default robust gate at its 100-σ ceiling (the
+            // same test as the configured gate when that is the default; a rejected
+            // update left the state as it was, so the trial starts from it).
+            let gross = gate == super::Gate::default() || {
+                let mut trial = f.clone();
+                trial.set_gate(super::Gate::default());
+                trial
+                    .update_position(llh, sigma, self.cfg.lever_arm_b_m)
+                    .map_or(true, |o| !o.accepted)
+            };
+            self.gross_in_row = if gross { self.gross_in_row + 1 } else { 0 };
         }
         outcomes.push(o);
         if let Some(v) = &gn.vel_ned_m_s {
@@ -612,6 +768,9 @@ pub fn run_forward_with(
         last_fix_s: t0,
         prev_fix: None,
         f_mean_b: None,
+        rejected_in_row: 0,
+        gross_in_row: 0,
+        count_armed: true,
         run: ForwardRun {
             epochs: Vec::with_capacity(if keep_epochs {
                 imu.len() - start + gnss.len() + 1
@@ -628,6 +787,7 @@ pub fn run_forward_with(
             gnss_inflated: 0,
             gnss_forced: 0,
             gnss_resets: 0,
+            recoveries: Vec::new(),
             gnss_accepted: 0,
             nhc_applied: 0,
             zupt_applied: 0,
