@@ -31,14 +31,14 @@ fn gyro_csv(path: &Path, rate_hz: f64, minutes: f64, seed: u64) {
         .map(|k| generate(&cfg, seed * 10 + k).unwrap())
         .collect();
     let mut s = String::from("t [s],gyro_x [deg/s],gyro_y [deg/s],gyro_z [deg/s]\n");
-    for i in 0..ch[0].len() {
+    for (i, ((x, y), z)) in ch[0].iter().zip(&ch[1]).zip(&ch[2]).enumerate() {
         let _ = writeln!(
             s,
             "{:.4},{:.7},{:.7},{:.7}",
             i as f64 / rate_hz,
-            ch[0][i] / DEG,
-            ch[1][i] / DEG,
-            ch[2][i] / DEG
+            x / DEG,
+            y / DEG,
+            z / DEG
         );
     }
     std::fs::write(path, s).unwrap();

@@ -479,7 +479,10 @@ fn cross_check(
     let tol = 1e-9;
     let mut worst: Option<(f64, f64)> = None;
     for p in &curve.points {
-        if p.tau < lo * (1.0 - tol) || p.tau > hi * (1.0 + tol) || !(p.dev > 0.0) {
+        if p.tau < lo * (1.0 - tol)
+            || p.tau > hi * (1.0 + tol)
+            || p.dev.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        {
             continue;
         }
         let d = (fit.model_avar(p.tau).sqrt() / p.dev - 1.0).abs();
