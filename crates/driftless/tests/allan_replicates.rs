@@ -161,7 +161,23 @@ fn replicate_test_false_alarms_and_power() {
         .map(|s| {
             let a = fit_run("a", &sim(1.0, 5000 + 2 * s));
             let b = fit_run("b", &sim(2.0, 5001 + 2 * s));
-            outcome(&compare(&a, &b))
+            let r = compare(&a, &b);
+            // Where the runs disagree the joint interval holds the pooled one.
+            for t in &r.channels[0].terms {
+                if let (Some(false), Some(p), Some(j)) = (t.consistent, t.pooled, t.joint) {
+                    assert!(j.lo <= p.lo && j.hi >= p.hi, "{t:?}");
+                    assert!(j.lo <= j.value && j.value <= j.hi, "{t:?}");
+                }
+            }
+            assert!(
+                r.warnings().len()
+                    == r.channels[0]
+                        .terms
+                        .iter()
+                        .filter(|t| t.consistent == Some(false))
+                        .count()
+            );
+            outcome(&r)
         })
         .collect();
     let fa = rates(&same);

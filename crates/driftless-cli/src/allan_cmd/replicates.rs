@@ -8,9 +8,10 @@ use super::{
 };
 use anyhow::{Context, Result, bail};
 use driftless::allan::replicates::{
-    DEFAULT_LEVEL, ReplicateOptions, ReplicateRun, Replicates, compare_replicates,
+    DEFAULT_LEVEL, ReplicateOptions, ReplicateRun, Replicates, RunShape, check_same_sensor,
+    compare_replicates,
 };
-use driftless::io::ImuLog;
+use driftless::io::{ImuLog, Quantity};
 use driftless::report::allan_plot::{self, RunCurves};
 use std::path::PathBuf;
 
@@ -40,7 +41,8 @@ pub(super) fn run_replicates(a: &AllanArgs) -> Result<()> {
             a.files.len()
         ),
     };
-    let mut runs = Vec::with_capacity(a.files.len());
+    // Read every log and check that they are replicates before the long work.
+    let mut logs = Vec::with_capacity(a.files.len());
     for file in &a.files {
         let log = read_with_progress(&a.input, file, a.json)?;
         for g in &log.gaps {
@@ -57,22 +59,45 @@ pub(super) fn run_replicates(a: &AllanArgs) -> Result<()> {
                 }
             );
         }
+        logs.push((file.clone(), file.display().to_string(), log));
+    }
+    {
+        let shapes: Vec<RunShape<'_>> = logs
+            .iter()
+            .map(|(_, name, log)| RunShape {
+                source: name,
+                channels: log
+                    .channels
+                    .iter()
+                    .filter(|c| c.quantity != Quantity::Temperature)
+                    .map(|c| (c.name.as_str(), c.quantity))
+                    .collect(),
+                tau0_s: log.tau0_s,
+            })
+            .collect();
+        if let [first, rest @ ..] = shapes.as_slice() {
+            for other in rest {
+                check_same_sensor(first, other)?;
+            }
+        }
+    }
+    let mut runs = Vec::with_capacity(logs.len());
+    for (file, name, log) in logs {
         let spinner = crate::demo_cmd::spinner(
             !a.json,
             format!(
-                "{}: {} on {} channel(s) × {} samples",
-                file.display(),
+                "{name}: {} on {} channel(s) × {} samples",
                 cfg.estimator.name().to_uppercase(),
                 log.channels.len(),
                 log.len()
             ),
         );
         let out = analyse_log_with(&log, &cfg, Some(&method), a.scale, !a.keep_lines)
-            .with_context(|| format!("analysing {}", file.display()))?;
+            .with_context(|| format!("analysing {name}"))?;
         spinner.finish_and_clear();
         runs.push(Run {
-            file: file.clone(),
-            name: file.display().to_string(),
+            file,
+            name,
             log,
             out,
         });
@@ -170,7 +195,7 @@ fn write_plot(path: &std::path::Path, runs: &[Run], rep: &Replicates) -> Result<
         .map(|c| {
             rep.joint
                 .channel(&c.name)
-                .map_or(driftless::io::Quantity::Other, |j| j.quantity)
+                .map_or(Quantity::Other, |j| j.quantity)
         })
         .collect();
     allan_plot::write_replicates(

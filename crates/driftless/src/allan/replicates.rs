@@ -501,13 +501,86 @@ fn fmt_p(p: f64) -> String {
     }
 }
 
+/// What two runs must share to be replicates: channels (name, quantity) and the sample
+/// interval. Known once the logs are read, before any analysis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunShape<'a> {
+    /// Name of the run (its file).
+    pub source: &'a str,
+    /// The analysed channels: name and quantity.
+    pub channels: Vec<(&'a str, Quantity)>,
+    /// Sample interval, s.
+    pub tau0_s: f64,
+}
+
+/// Whether `other` can be a replicate of `first`: the same channel names (any order) with
+/// the same quantities and sample rates within [`SAMPLE_RATE_TOLERANCE`]. The error names
+/// both runs and what differs.
+pub fn check_same_sensor(first: &RunShape<'_>, other: &RunShape<'_>) -> Result<(), ReplicateError> {
+    let mismatch = |what: String| ReplicateError::Mismatch {
+        first: first.source.into(),
+        other: other.source.into(),
+        what,
+    };
+    fn only<'x>(a: &RunShape<'x>, b: &RunShape<'_>) -> Vec<&'x str> {
+        let mut v: Vec<&'x str> = a
+            .channels
+            .iter()
+            .map(|(n, _)| *n)
+            .filter(|n| !b.channels.iter().any(|(c, _)| c == n))
+            .collect();
+        v.sort_unstable();
+        v
+    }
+    let (only_a, only_b) = (only(first, other), only(other, first));
+    if !only_a.is_empty() || !only_b.is_empty() || first.channels.len() != other.channels.len() {
+        let mut parts = Vec::new();
+        if !only_a.is_empty() {
+            parts.push(format!("only {} has {}", first.source, only_a.join(", ")));
+        }
+        if !only_b.is_empty() {
+            parts.push(format!("only {} has {}", other.source, only_b.join(", ")));
+        }
+        if parts.is_empty() {
+            parts.push(format!(
+                "{} vs {} channels",
+                first.channels.len(),
+                other.channels.len()
+            ));
+        }
+        return Err(mismatch(format!(
+            "the channels differ ({})",
+            parts.join("; ")
+        )));
+    }
+    for (n, qa) in &first.channels {
+        if let Some((_, qb)) = other.channels.iter().find(|(m, _)| m == n)
+            && qa != qb
+        {
+            return Err(mismatch(format!(
+                "channel '{n}' is {qa:?} in one and {qb:?} in the other"
+            )));
+        }
+    }
+    if !(first.tau0_s > 0.0 && other.tau0_s > 0.0)
+        || (other.tau0_s / first.tau0_s - 1.0).abs() > SAMPLE_RATE_TOLERANCE
+    {
+        return Err(mismatch(format!(
+            "the sample rates differ ({} Hz vs {} Hz)",
+            fmt_num(1.0 / first.tau0_s),
+            fmt_num(1.0 / other.tau0_s)
+        )));
+    }
+    Ok(())
+}
+
 /// Compare replicate runs of one sensor and fit their joint model (module doc).
 ///
 /// Channels are matched by name; the runs must have the same channels with the same
 /// quantities, the same estimator and confidence, and sample rates within
 /// [`SAMPLE_RATE_TOLERANCE`] — otherwise the error names both files and what differs.
-pub fn compare_replicates(
-    runs: &[ReplicateRun<'_>],
+pub fn compare_replicates<'a>(
+    runs: &[ReplicateRun<'a>],
     opts: &ReplicateOptions,
 ) -> Result<Replicates, ReplicateError> {
     let [first, rest @ ..] = runs else {
@@ -539,11 +612,22 @@ pub fn compare_replicates(
             }
         }
     }
-    let names = |r: &ReplicateRun<'_>| -> Vec<String> {
-        let mut v: Vec<String> = r.curves.iter().map(|c| c.name.clone()).collect();
-        v.sort();
-        v
+    let shape = |r: &ReplicateRun<'a>| RunShape {
+        source: r.source,
+        channels: r
+            .curves
+            .iter()
+            .map(|c| {
+                let q = r
+                    .model
+                    .channel(&c.name)
+                    .map_or(Quantity::Other, |m| m.quantity);
+                (c.name.as_str(), q)
+            })
+            .collect(),
+        tau0_s: r.curves[0].tau0_s,
     };
+    let first_shape = shape(first);
     let c0 = &first.curves[0];
     for r in rest {
         let mismatch = |what: String| ReplicateError::Mismatch {
@@ -551,41 +635,7 @@ pub fn compare_replicates(
             other: r.source.into(),
             what,
         };
-        let (a, b) = (names(first), names(r));
-        if a != b {
-            let only_a: Vec<&str> = a
-                .iter()
-                .filter(|n| !b.contains(n))
-                .map(String::as_str)
-                .collect();
-            let only_b: Vec<&str> = b
-                .iter()
-                .filter(|n| !a.contains(n))
-                .map(String::as_str)
-                .collect();
-            let mut parts = Vec::new();
-            if !only_a.is_empty() {
-                parts.push(format!("only {} has {}", first.source, only_a.join(", ")));
-            }
-            if !only_b.is_empty() {
-                parts.push(format!("only {} has {}", r.source, only_b.join(", ")));
-            }
-            if parts.is_empty() {
-                parts.push(format!("channels [{}] vs [{}]", a.join(", "), b.join(", ")));
-            }
-            return Err(mismatch(format!(
-                "the channels differ ({})",
-                parts.join("; ")
-            )));
-        }
-        let c1 = &r.curves[0];
-        if (c1.tau0_s / c0.tau0_s - 1.0).abs() > SAMPLE_RATE_TOLERANCE {
-            return Err(mismatch(format!(
-                "the sample rates differ ({} Hz vs {} Hz)",
-                fmt_num(1.0 / c0.tau0_s),
-                fmt_num(1.0 / c1.tau0_s)
-            )));
-        }
+        check_same_sensor(&first_shape, &shape(r))?;
         for c in r.curves {
             let Some(f) = first.curves.iter().find(|f| f.name == c.name) else {
                 continue;
@@ -608,17 +658,6 @@ pub fn compare_replicates(
                 return Err(mismatch(format!(
                     "the confidence levels differ ({} vs {})",
                     f.confidence, c.confidence
-                )));
-            }
-            let qa = first.model.channel(&c.name).map(|m| m.quantity);
-            let qb = r.model.channel(&c.name).map(|m| m.quantity);
-            if qa != qb {
-                let show = |q: Option<Quantity>| q.map_or("-".to_string(), |q| format!("{q:?}"));
-                return Err(mismatch(format!(
-                    "channel '{}' is {} in one and {} in the other",
-                    c.name,
-                    show(qa),
-                    show(qb)
                 )));
             }
         }
@@ -1034,6 +1073,49 @@ mod tests {
         assert!(cochran_dersimonian_laird(&[1.0], &[1.0]).is_none());
         assert!(cochran_dersimonian_laird(&[1.0, 2.0], &[1.0, 0.0]).is_none());
         assert!(cochran_dersimonian_laird(&[1.0, f64::NAN], &[1.0, 1.0]).is_none());
+    }
+
+    #[test]
+    fn same_sensor_check_names_both_runs_and_what_differs() {
+        let a = RunShape {
+            source: "a.csv",
+            channels: vec![
+                ("gyro_x", Quantity::AngularRate),
+                ("accel_x", Quantity::SpecificForce),
+            ],
+            tau0_s: 0.01,
+        };
+        // Same channels in another order, a rate within the tolerance: replicates.
+        let b = RunShape {
+            source: "b.csv",
+            channels: vec![a.channels[1], a.channels[0]],
+            tau0_s: 0.01 * (1.0 + 1e-4),
+        };
+        assert!(check_same_sensor(&a, &b).is_ok());
+        let q = RunShape {
+            channels: vec![
+                ("gyro_x", Quantity::AngularRate),
+                ("accel_x", Quantity::Other),
+            ],
+            ..b.clone()
+        };
+        let e = check_same_sensor(&a, &q).unwrap_err().to_string();
+        assert!(
+            e.contains("a.csv") && e.contains("b.csv") && e.contains("accel_x"),
+            "{e}"
+        );
+        let r = RunShape {
+            tau0_s: 0.005,
+            ..b.clone()
+        };
+        let e = check_same_sensor(&a, &r).unwrap_err().to_string();
+        assert!(e.contains("100.00 Hz vs 200.00 Hz"), "{e}");
+        let c = RunShape {
+            channels: vec![("gyro_x", Quantity::AngularRate)],
+            ..b
+        };
+        let e = check_same_sensor(&a, &c).unwrap_err().to_string();
+        assert!(e.contains("only a.csv has accel_x"), "{e}");
     }
 
     #[test]
