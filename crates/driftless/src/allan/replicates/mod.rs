@@ -602,7 +602,11 @@ fn fit_joint(
             if runs_range.is_some()
                 && let Some(r) = ch.fit.fit_range.as_mut()
             {
-                r.source = RangeSource::Auto;
+                r.source = if r.excluded_short == 0 && r.excluded_long == 0 {
+                    RangeSource::Full
+                } else {
+                    RangeSource::Auto
+                };
             }
             joint.channels.push(ch);
         }
