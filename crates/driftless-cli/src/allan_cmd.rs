@@ -16,6 +16,9 @@ use driftless::io::{ImuLog, Quantity};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
+mod replicates;
+use replicates::run_replicates;
+
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum DataTypeArg {
     /// Rates (rad/s, m/s², fractional frequency).
@@ -37,8 +40,11 @@ pub enum MethodArg {
 
 #[derive(Args, Debug)]
 pub struct AllanArgs {
-    /// The log: delimited text (CSV, whitespace, single column) or a binary DRIFTLOG file.
-    pub file: PathBuf,
+    /// The log(s): delimited text (CSV, whitespace, single column) or binary DRIFTLOG
+    /// files. Several files are replicate runs of one sensor: each is analysed, the runs'
+    /// noise terms are compared and a joint model is fitted to them all.
+    #[arg(required = true, num_args = 1.., value_name = "FILE")]
+    pub files: Vec<PathBuf>,
     /// Whether the values are rates (freq) or integrated (phase).
     #[arg(long, value_enum, default_value = "freq")]
     pub data_type: DataTypeArg,
@@ -113,6 +119,11 @@ pub struct AllanOutput {
     pub warnings: Vec<String>,
     /// Spectral lines found per channel (removed before the noise fit).
     pub lines: Vec<ChannelLines>,
+    /// The OADEV curves the Allan noise model was fitted to (line-free where lines were
+    /// found), in channel order; empty without the Allan fit.
+    pub fit_curves: Vec<ChannelResult>,
+    /// Resolution step of each channel's rate samples, as used by the Allan fit.
+    pub resolution: Vec<Option<f64>>,
 }
 
 /// The analysis settings from the flags.
@@ -301,6 +312,7 @@ pub fn analyse_log_with(
         fit_curves[k] = cc;
     }
     let mut gmwm_channels = Vec::new();
+    let mut resolution_used = Vec::new();
     let noise = match method {
         None => None,
         Some(NoiseMethod::Gmwm(gc)) => {
@@ -316,6 +328,7 @@ pub fn analyse_log_with(
                     .collect(),
                 DataType::Phase => Vec::new(),
             };
+            resolution_used.clone_from(&resolution);
             let opts = ModelOptions {
                 fit_range: *range,
                 resolution,
@@ -403,25 +416,37 @@ pub fn analyse_log_with(
         gmwm: gmwm_channels,
         warnings,
         lines: lines_out,
+        fit_curves: if matches!(method, Some(NoiseMethod::Allan(..))) {
+            fit_curves
+        } else {
+            Vec::new()
+        },
+        resolution: resolution_used,
     })
 }
 
 pub fn run(a: AllanArgs) -> Result<()> {
+    let inputs: Vec<Option<&Path>> = a.files.iter().map(|f| Some(f.as_path())).collect();
     crate::paths::refuse_outputs_over_inputs(
         &[a.save_model.as_deref(), a.plot.as_deref()],
-        &[Some(&a.file)],
+        &inputs,
     )?;
+    let file = match a.files.as_slice() {
+        [] => bail!("allan needs a log file"),
+        [one] => one,
+        _ => return run_replicates(&a),
+    };
     let cfg = analysis_config(&a)?;
     let fit = if a.no_fit {
         None
     } else {
         Some(noise_method(&a)?)
     };
-    let log = read_with_progress(&a.input, &a.file, a.json)?;
+    let log = read_with_progress(&a.input, file, a.json)?;
     for g in &log.gaps {
         eprintln!(
             "warning: {}: time gap of {:.3} s after t = {:.3} s (row {}) — {}",
-            a.file.display(),
+            file.display(),
             g.duration_s,
             g.start_s,
             g.index + 1,
@@ -457,12 +482,12 @@ pub fn run(a: AllanArgs) -> Result<()> {
             .with_context(|| format!("writing noise model {}", p.display()))?;
     }
     if let Some(p) = &a.plot {
-        crate::demo_cmd::write_plot(p, &out, &a.file.display().to_string())?;
+        crate::demo_cmd::write_plot(p, &out, &file.display().to_string())?;
     }
     if a.json {
         outln!("{}", serde_json::to_string_pretty(&json_output(&out))?);
     } else {
-        out!("{}", human_output(&out, &log, &a.file));
+        out!("{}", human_output(&out, &log, file));
         if let Some(p) = &a.plot {
             outln!("plot written to {}", p.display());
         }
@@ -520,10 +545,28 @@ pub fn read_with_progress(input: &InputArgs, path: &Path, quiet: bool) -> Result
 
 /// The `--json` document: `{"channels":[…], "noise": {…}}`.
 pub fn json_output(out: &AllanOutput) -> serde_json::Value {
-    let channels: Vec<serde_json::Value> = out
-        .results
+    let channels = channels_json(&out.results, &out.units);
+    let noise = match &out.noise {
+        Some(m) => noise_json(m, out.gmwm.is_empty()),
+        None => serde_json::Value::Null,
+    };
+    let mut doc = serde_json::json!({
+        "channels": channels,
+        "noise": noise,
+        "warnings": out.warnings,
+        "lines": out.lines,
+    });
+    if !out.gmwm.is_empty() {
+        doc["gmwm"] = serde_json::to_value(&out.gmwm).unwrap_or(serde_json::Value::Null);
+    }
+    doc
+}
+
+/// The curves of the `--json` document.
+fn channels_json(results: &[ChannelResult], units: &[String]) -> Vec<serde_json::Value> {
+    results
         .iter()
-        .zip(&out.units)
+        .zip(units)
         .map(|(r, unit)| {
             serde_json::json!({
                 "name": r.name,
@@ -542,12 +585,14 @@ pub fn json_output(out: &AllanOutput) -> serde_json::Value {
                 "rate_acf1": r.rate_acf1,
             })
         })
-        .collect();
-    let mut noise = match &out.noise {
-        Some(m) => serde_json::to_value(m).unwrap_or(serde_json::Value::Null),
-        None => serde_json::Value::Null,
-    };
-    if let (Some(m), true) = (&out.noise, out.gmwm.is_empty())
+        .collect()
+}
+
+/// A noise model in the `--json` document; an Allan fit's channels carry the χ²_red
+/// verdict.
+fn noise_json(m: &NoiseModel, allan_fit: bool) -> serde_json::Value {
+    let mut noise = serde_json::to_value(m).unwrap_or(serde_json::Value::Null);
+    if allan_fit
         && let Some(chs) = noise
             .get_mut("channels")
             .and_then(serde_json::Value::as_array_mut)
@@ -560,16 +605,7 @@ pub fn json_output(out: &AllanOutput) -> serde_json::Value {
             }
         }
     }
-    let mut doc = serde_json::json!({
-        "channels": channels,
-        "noise": noise,
-        "warnings": out.warnings,
-        "lines": out.lines,
-    });
-    if !out.gmwm.is_empty() {
-        doc["gmwm"] = serde_json::to_value(&out.gmwm).unwrap_or(serde_json::Value::Null);
-    }
-    doc
+    noise
 }
 
 fn human_output(out: &AllanOutput, log: &ImuLog, file: &Path) -> String {

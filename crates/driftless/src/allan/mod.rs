@@ -16,6 +16,7 @@ pub mod lines;
 pub mod noise_model;
 pub mod phase;
 pub mod plausibility;
+pub mod replicates;
 pub mod taus;
 
 use serde::{Deserialize, Serialize};

@@ -47,7 +47,7 @@ const ALL_TERMS: [TermKind; 6] = [
     TermKind::GaussMarkov,
 ];
 
-fn term_label(k: TermKind) -> &'static str {
+pub(crate) fn term_label(k: TermKind) -> &'static str {
     match k {
         TermKind::Quantization => "quantization Q",
         TermKind::White => "white N",
@@ -59,7 +59,7 @@ fn term_label(k: TermKind) -> &'static str {
 }
 
 /// SI unit of each term for rate samples in `unit` (u·s, u·√s, u, u/√s, u/s).
-fn si_term_units(unit: &str) -> impl Fn(TermKind) -> String + '_ {
+pub(crate) fn si_term_units(unit: &str) -> impl Fn(TermKind) -> String + '_ {
     let u = if unit.is_empty() { "u" } else { unit };
     move |k| match k {
         TermKind::Quantization => format!("({u})·s"),
@@ -70,7 +70,7 @@ fn si_term_units(unit: &str) -> impl Fn(TermKind) -> String + '_ {
     }
 }
 
-fn fmt_num(v: f64) -> String {
+pub(crate) fn fmt_num(v: f64) -> String {
     if v == 0.0 {
         "0".into()
     } else if !v.is_finite() {

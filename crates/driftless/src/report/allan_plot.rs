@@ -238,3 +238,107 @@ pub fn write(
 ) -> Result<(), PlotError> {
     super::plot::write_figure(&figure(title, results, quantities, units, fits), path)
 }
+
+/// One run of a replicate figure: its name (shown in the legend) and its curves.
+pub struct RunCurves<'a> {
+    /// Legend name of the run (its file name).
+    pub name: &'a str,
+    /// The run's curves (channels matched by name).
+    pub results: &'a [ChannelResult],
+}
+
+/// Replicate runs of one sensor overlaid: one log-log panel per channel (the first run's
+/// channels, matched by name) with every run's deviation and confidence bars, and the
+/// joint model `joint[i]` (fitted to the combined curves, see
+/// [`crate::allan::replicates`]) over the τ span of the runs.
+pub fn replicates_figure(
+    title: &str,
+    runs: &[RunCurves<'_>],
+    quantities: &[Quantity],
+    units: &[String],
+    joint: &[Option<&NoiseFit>],
+) -> Figure {
+    let Some(first) = runs.first() else {
+        return Figure::grid(Vec::new(), 1).with_title(title);
+    };
+    let mut panels = Vec::with_capacity(first.results.len());
+    for (i, r0) in first.results.iter().enumerate() {
+        let q = quantities.get(i).copied().unwrap_or(Quantity::Other);
+        let (k, unit) = axis_unit(q, units.get(i).map(String::as_str).unwrap_or(""));
+        let mut plot = LogLogPlot::new(
+            format!(
+                "{} — {}, {} runs",
+                r0.name,
+                r0.estimator.name().to_uppercase(),
+                runs.len()
+            ),
+            "averaging time τ (s)",
+            format!("σ(τ) ({unit})"),
+        );
+        let (mut tmin, mut tmax) = (f64::INFINITY, 0.0f64);
+        let (mut ymin, mut ymax) = (f64::INFINITY, 0.0f64);
+        for (j, run) in runs.iter().enumerate() {
+            let Some(r) = run.results.iter().find(|c| c.name == r0.name) else {
+                continue;
+            };
+            let tau: Vec<f64> = r.points.iter().map(|p| p.tau).collect();
+            let dev: Vec<f64> = r.points.iter().map(|p| p.dev * k).collect();
+            let lo: Vec<f64> = r.dev_lo.iter().map(|v| v * k).collect();
+            let hi: Vec<f64> = r.dev_hi.iter().map(|v| v * k).collect();
+            for v in dev.iter().chain(&lo).chain(&hi) {
+                if v.is_finite() && *v > 0.0 {
+                    ymin = ymin.min(*v);
+                    ymax = ymax.max(*v);
+                }
+            }
+            tmin = tmin.min(tau.first().copied().unwrap_or(tmin));
+            tmax = tmax.max(tau.last().copied().unwrap_or(tmax));
+            plot = plot.with_series(
+                Series::new(
+                    format!("{} ({:.1} % CI)", run.name, 100.0 * r.confidence),
+                    tau,
+                    dev,
+                )
+                .with_ci(lo, hi)
+                .with_color(PALETTE[j % PALETTE.len()]),
+            );
+        }
+        if let Some(Some(f)) = joint.get(i)
+            && tmax > tmin
+        {
+            let n = 64;
+            let tau: Vec<f64> = (0..=n)
+                .map(|s| tmin * (tmax / tmin).powf(s as f64 / n as f64))
+                .collect();
+            let y: Vec<f64> = tau.iter().map(|&t| f.model_avar(t).sqrt() * k).collect();
+            plot = plot.with_line(
+                Line::new("joint model", tau, y).with_color(Color::rgb(0x20, 0x20, 0x20)),
+            );
+        }
+        if ymin.is_finite() && ymax > 0.0 {
+            plot.y_range = Some((ymin / 1.3, ymax * 1.3));
+        }
+        panels.push(plot);
+    }
+    let cols = match panels.len() {
+        0..=1 => 1,
+        2 | 4 => 2,
+        _ => 3,
+    };
+    Figure::grid(panels, cols).with_title(title)
+}
+
+/// Write [`replicates_figure`] to `path` (`.png` → PNG with the `png` feature, else SVG).
+pub fn write_replicates(
+    path: &Path,
+    title: &str,
+    runs: &[RunCurves<'_>],
+    quantities: &[Quantity],
+    units: &[String],
+    joint: &[Option<&NoiseFit>],
+) -> Result<(), PlotError> {
+    super::plot::write_figure(
+        &replicates_figure(title, runs, quantities, units, joint),
+        path,
+    )
+}
