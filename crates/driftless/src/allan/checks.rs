@@ -26,7 +26,7 @@ use super::fit::{NoiseFit, TermKind};
 pub const NON_STATIONARY_FACTOR: f64 = 10.0;
 
 /// χ²_k quantile at standard-normal quantile z (Wilson–Hilferty).
-fn chi2_quantile(k: f64, z: f64) -> f64 {
+pub(crate) fn chi2_quantile(k: f64, z: f64) -> f64 {
     let a = 2.0 / (9.0 * k);
     k * (1.0 - a + z * a.sqrt()).powi(3).max(0.0)
 }

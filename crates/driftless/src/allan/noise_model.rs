@@ -461,14 +461,15 @@ pub const AUTO_RANGE_MIN_POINTS: usize = 12;
 /// points are kept.
 pub fn auto_fit_end(c: &ChannelResult, precision: f64) -> usize {
     let n = c.points.len();
-    // The lower χ² point of the two-sided interval.
-    let p_lo = 0.5 * (1.0 - CURVE_PRECISION_CONFIDENCE);
+    // The lower χ² point of the two-sided interval (Wilson–Hilferty: a few 0.1 % at the
+    // ν of a few tens this decides at).
+    let z_lo = super::fit::normal_quantile(0.5 * (1.0 - CURVE_PRECISION_CONFIDENCE));
     let end = (0..n)
         .position(|i| {
             let nu = c.edf_for_alpha(i, -1).min(c.edf_for_alpha(i, -2));
             !(nu.is_finite()
                 && nu > 0.0
-                && (nu / super::ci::chi2::chi2_quantile(p_lo, nu)).sqrt() <= 1.0 + precision)
+                && (nu / super::checks::chi2_quantile(nu, z_lo)).sqrt() <= 1.0 + precision)
         })
         .unwrap_or(n);
     end.max(AUTO_RANGE_MIN_POINTS).min(n)
@@ -858,6 +859,12 @@ impl NoiseModel {
                 model_error_floor: opts.model_error_floor,
             };
             let step = opts.resolution.get(k).copied().flatten();
+            // EDF of every point for every noise exponent, once: the fits below ask for
+            // them thousands of times.
+            let edf_table: Vec<[f64; 5]> = (0..tau.len())
+                .map(|i| [-2, -1, 0, 1, 2].map(|a| c.edf_for_alpha(i, a)))
+                .collect();
+            let edf_of = |i: usize, alpha: i32| edf_table[i][(alpha.clamp(-2, 2) + 2) as usize];
             let fit_with = |i0: usize, i1: usize, cfg: &FitConfig| {
                 if i0 >= i1 || i1 > tau.len() {
                     return Err(AllanError::Invalid(format!(
@@ -868,7 +875,7 @@ impl NoiseModel {
                     fit_noise_with_edf_opts(
                         &tau[i0..i1],
                         &avar[i0..i1],
-                        |i, a| c.edf_for_alpha(i0 + i, a),
+                        |i, a| edf_of(i0 + i, a),
                         cfg,
                         confidence,
                         &fit_opts,
@@ -914,7 +921,10 @@ impl NoiseModel {
                         .iter()
                         .max()
                         .map_or(0, |n| n.saturating_sub(1));
-                    let coloured = short_tau_coloured(&c.rate_acf1, longest);
+                    let coloured = short_tau_coloured(
+                        &c.rate_acf1,
+                        longest.min(super::analysis::MAX_ACF_BLOCKS),
+                    );
                     let m: Vec<usize> = c.points.iter().map(|p| p.m).collect();
                     // Mean squared normalised residual over points `idx`, with the
                     // fit's own weights.
@@ -922,7 +932,7 @@ impl NoiseModel {
                         let (mut sum, mut k) = (0.0, 0usize);
                         for i in idx {
                             let model = f.model_avar(tau[i]);
-                            let nu = c.edf_for_alpha(i, f.dominant_alpha(tau[i]));
+                            let nu = edf_of(i, f.dominant_alpha(tau[i]));
                             if model > 0.0 && nu > 0.0 {
                                 let var =
                                     model * model * (2.0 / nu + opts.model_error_floor.powi(2));

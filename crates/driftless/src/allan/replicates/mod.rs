@@ -585,6 +585,8 @@ fn fit_joint(
             fit_range: opts.fit_range.or(runs_range),
             resolution: vec![steps.and_then(|v| v.into_iter().reduce(f64::max))],
             model_error_floor: opts.model_error_floor,
+            // The range is the runs' common one, whose ends their own fits chose.
+            curve_precision: None,
         };
         let one = NoiseModel::from_curves_with(
             &source,
