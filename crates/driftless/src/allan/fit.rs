@@ -817,7 +817,22 @@ pub fn fit_noise_opts(
         )));
     }
     let kinds = cfg.linear_terms();
-    let n_par = kinds.len() + if cfg.gauss_markov { 2 } else { 0 };
+    // A Gauss-Markov term needs two parameters beyond the linear terms; a curve too short
+    // for them is fitted without it, and says so.
+    let mut not_identifiable = Vec::new();
+    let with_gm = cfg.gauss_markov && (kinds.is_empty() || tau.len() > kinds.len() + 2);
+    if cfg.gauss_markov && !with_gm {
+        not_identifiable.push(NotIdentifiable {
+            term: TermKind::GaussMarkov,
+            reason: format!(
+                "{} curve points are too few for its σ and correlation time beside {} other \
+                 term(s)",
+                tau.len(),
+                kinds.len()
+            ),
+        });
+    }
+    let n_par = kinds.len() + if with_gm { 2 } else { 0 };
     if n_par == 0 {
         return Err(AllanError::Invalid("fit: no noise term switched on".into()));
     }
@@ -838,8 +853,7 @@ pub fn fit_noise_opts(
 
     // Optional Gauss-Markov: separable search over ln T.
     let mut gm_t: Option<f64> = None;
-    let mut not_identifiable = Vec::new();
-    if cfg.gauss_markov {
+    if with_gm {
         let (tmin, tmax) = tau
             .iter()
             .fold((f64::INFINITY, 0.0f64), |(a, b), &t| (a.min(t), b.max(t)));
@@ -1544,6 +1558,24 @@ mod tests {
             zeros > 100,
             "the trials must exercise the constraint: {zeros}"
         );
+    }
+
+    #[test]
+    fn a_curve_too_short_for_a_gauss_markov_term_is_fitted_without_it() {
+        // Six octave points of white noise plus a floor: enough for the five linear
+        // terms, not for seven parameters.
+        let tau: Vec<f64> = (0..6).map(|i| 2f64.powi(i)).collect();
+        let avar: Vec<f64> = tau.iter().map(|t| 1e-6 / t + 1e-9).collect();
+        let edf = vec![100.0; 6];
+        let f = fit_noise(&tau, &avar, &edf, &FitConfig::default(), 0.683).expect("fit");
+        assert!(f.gauss_markov.is_none());
+        let ni = f
+            .not_identifiable
+            .iter()
+            .find(|n| n.term == TermKind::GaussMarkov)
+            .expect("reported");
+        assert!(ni.reason.contains("too few"), "{ni:?}");
+        assert!(f.white.is_some());
     }
 
     #[test]
