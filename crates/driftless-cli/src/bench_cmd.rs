@@ -587,7 +587,7 @@ fn bench_input(
 }
 
 /// The CSV a data logger writes: time to 0.01 s, samples with 7 significant digits
-/// (a 16-bit MEMS output carries about 5), as in the issue's ~650 MB 18-h log.
+/// (a 16-bit MEMS output carries about 5), as in a user's ~650 MB 18-h log.
 fn write_logger_csv(log: &ImuLog, path: &std::path::Path) -> Result<()> {
     use std::io::Write;
     let mut f = driftless::io::output::AtomicFile::create(path)
