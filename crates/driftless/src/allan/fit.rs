@@ -124,6 +124,20 @@ impl std::str::FromStr for FitConfig {
 }
 
 impl FitConfig {
+    /// The same selection with `kind` switched off.
+    pub fn without(self, kind: TermKind) -> FitConfig {
+        let mut c = self;
+        match kind {
+            TermKind::Quantization => c.quantization = false,
+            TermKind::White => c.white = false,
+            TermKind::BiasInstability => c.bias_instability = false,
+            TermKind::RateRandomWalk => c.rate_random_walk = false,
+            TermKind::RateRamp => c.rate_ramp = false,
+            TermKind::GaussMarkov => c.gauss_markov = false,
+        }
+        c
+    }
+
     /// The five terms of IEEE Std 952-1997: quantization, white noise, bias
     /// instability, rate random walk, rate ramp.
     pub const IEEE_952: FitConfig = FitConfig {
@@ -189,6 +203,15 @@ pub enum TermKind {
 }
 
 impl TermKind {
+    /// The linear terms of IEEE Std 952, in model order.
+    pub const LINEAR: [TermKind; 5] = [
+        TermKind::Quantization,
+        TermKind::White,
+        TermKind::BiasInstability,
+        TermKind::RateRandomWalk,
+        TermKind::RateRamp,
+    ];
+
     /// Allan variance per unit squared coefficient at `tau` (linear terms; the
     /// Gauss-Markov shape depends on T, see [`gauss_markov_avar`]).
     pub fn basis(self, tau: f64) -> f64 {
@@ -516,13 +539,7 @@ impl NoiseFit {
     /// where a model's intervals say another recording of the sensor may lie.
     pub fn model_avar_band(&self, tau: f64) -> (f64, f64) {
         let (mut lo, mut hi) = (0.0, 0.0);
-        for kind in [
-            TermKind::Quantization,
-            TermKind::White,
-            TermKind::BiasInstability,
-            TermKind::RateRandomWalk,
-            TermKind::RateRamp,
-        ] {
+        for kind in TermKind::LINEAR {
             let basis = kind.basis(tau);
             if let Some(t) = self.term(kind) {
                 lo += t.lo * t.lo * basis;
@@ -557,6 +574,18 @@ impl NoiseFit {
         (lo, hi)
     }
 
+    /// Removes the fitted term of a kind from the values.
+    pub fn clear_term(&mut self, kind: TermKind) {
+        match kind {
+            TermKind::Quantization => self.quantization = None,
+            TermKind::White => self.white = None,
+            TermKind::BiasInstability => self.bias_instability = None,
+            TermKind::RateRandomWalk => self.rate_random_walk = None,
+            TermKind::RateRamp => self.rate_ramp = None,
+            TermKind::GaussMarkov => self.gauss_markov = None,
+        }
+    }
+
     /// The fitted term of a kind (Gauss-Markov: its σ).
     pub fn term(&self, kind: TermKind) -> Option<Term> {
         match kind {
@@ -577,13 +606,7 @@ impl NoiseFit {
                 best = Some((k, v));
             }
         };
-        for k in [
-            TermKind::Quantization,
-            TermKind::White,
-            TermKind::BiasInstability,
-            TermKind::RateRandomWalk,
-            TermKind::RateRamp,
-        ] {
+        for k in TermKind::LINEAR {
             if let Some(t) = self.term(k) {
                 consider(k, t.value * t.value * k.basis(tau));
             }

@@ -630,16 +630,10 @@ pub fn least_supported_term(
             f64::INFINITY
         }
     };
-    let mut candidates: Vec<(TermKind, Term)> = [
-        TermKind::Quantization,
-        TermKind::White,
-        TermKind::BiasInstability,
-        TermKind::RateRandomWalk,
-        TermKind::RateRamp,
-    ]
-    .into_iter()
-    .filter_map(|k| fit.term(k).map(|t| (k, t)))
-    .collect();
+    let mut candidates: Vec<(TermKind, Term)> = TermKind::LINEAR
+        .into_iter()
+        .filter_map(|k| fit.term(k).map(|t| (k, t)))
+        .collect();
     if let Some(g) = fit.gauss_markov {
         candidates.push((TermKind::GaussMarkov, g.sigma));
     }
@@ -678,15 +672,7 @@ where
     let mut fit = fit_with(&cfg)?;
     while let Some((kind, why)) = least_supported_term(&fit, step, tau0_s) {
         dropped.push(why);
-        let mut next = cfg;
-        match kind {
-            TermKind::Quantization => next.quantization = false,
-            TermKind::White => next.white = false,
-            TermKind::BiasInstability => next.bias_instability = false,
-            TermKind::RateRandomWalk => next.rate_random_walk = false,
-            TermKind::RateRamp => next.rate_ramp = false,
-            TermKind::GaussMarkov => next.gauss_markov = false,
-        }
+        let next = cfg.without(kind);
         let refit = if next.linear_terms().is_empty() && !next.gauss_markov {
             None
         } else {
@@ -699,14 +685,7 @@ where
             }
             None => {
                 // Nothing left to refit with: report the term and leave it out.
-                match kind {
-                    TermKind::Quantization => fit.quantization = None,
-                    TermKind::White => fit.white = None,
-                    TermKind::BiasInstability => fit.bias_instability = None,
-                    TermKind::RateRandomWalk => fit.rate_random_walk = None,
-                    TermKind::RateRamp => fit.rate_ramp = None,
-                    TermKind::GaussMarkov => fit.gauss_markov = None,
-                }
+                fit.clear_term(kind);
                 break;
             }
         }
@@ -1348,13 +1327,7 @@ mod tests {
         let all = FitConfig::default();
         let fit = fit_supported_terms(&all, None, 0.01, fit_with).expect("fit");
         // Every term that stands is resolved from zero …
-        for k in [
-            TermKind::Quantization,
-            TermKind::White,
-            TermKind::BiasInstability,
-            TermKind::RateRandomWalk,
-            TermKind::RateRamp,
-        ] {
+        for k in TermKind::LINEAR {
             if let Some(t) = fit.term(k) {
                 assert!(t.lo > 0.0, "{k:?} {t:?}");
             }
