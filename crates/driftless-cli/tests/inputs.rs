@@ -243,3 +243,110 @@ fn a_model_file_over_the_size_cap_is_refused_naming_it() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+fn simulate_drive(out: &Path) {
+    let scenario =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios/city-drive.toml");
+    let o = bin()
+        .args(["simulate", "--json", "--out"])
+        .arg(out)
+        .arg(scenario)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o).1);
+}
+
+/// `nav` reads its IMU and GNSS files once, so standard input works for either when the IMU
+/// format is stated; with `auto` a pipe is refused (detection would consume its first
+/// line), naming the flag to set. `/dev/zero` as the GNSS file ends in an error at once.
+#[test]
+fn nav_reads_standard_input_once_or_says_what_to_set() {
+    let d = scratch("navpipe");
+    let sim = d.join("sim");
+    simulate_drive(&sim);
+    let imu = std::fs::read(sim.join("imu.txt")).unwrap();
+    let gnss = std::fs::read(sim.join("gnss.txt")).unwrap();
+    let run = |imu_arg: &Path, gnss_arg: &Path, extra: &[&str], input: &[u8]| {
+        with_stdin(
+            bin()
+                .args(["nav", "--json", "--imu"])
+                .arg(imu_arg)
+                .arg("--gnss")
+                .arg(gnss_arg)
+                .args(extra),
+            input,
+        )
+    };
+    let (imu_file, gnss_file) = (sim.join("imu.txt"), sim.join("gnss.txt"));
+    let stdin = Path::new("/dev/stdin");
+    let file = run(&imu_file, &gnss_file, &[], b"");
+    assert!(file.status.success(), "{}", text(&file).1);
+    let piped_imu = run(stdin, &gnss_file, &["--imu-format", "kfgins"], &imu);
+    assert!(piped_imu.status.success(), "{}", text(&piped_imu).1);
+    assert_eq!(piped_imu.stdout, file.stdout);
+    let piped_gnss = run(&imu_file, stdin, &[], &gnss);
+    assert!(piped_gnss.status.success(), "{}", text(&piped_gnss).1);
+    assert_eq!(piped_gnss.stdout, file.stdout);
+
+    let auto = run(stdin, &gnss_file, &[], &imu);
+    let (out, err) = text(&auto);
+    assert_eq!(auto.status.code(), Some(1), "{out}");
+    assert!(
+        err.contains("/dev/stdin") && err.contains("--imu-format") && out.is_empty(),
+        "{err}"
+    );
+
+    let (o, took, finished) = bounded(
+        bin()
+            .args(["nav", "--imu"])
+            .arg(&imu_file)
+            .args(["--gnss", "/dev/zero"]),
+        Duration::from_secs(10),
+    );
+    assert!(finished && took < Duration::from_secs(5), "{took:?}");
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        text(&o).1.contains("/dev/zero: binary data"),
+        "{}",
+        text(&o).1
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A KF-GINS configuration whose GNSS file belongs to another trajectory (a leftover of
+/// another simulation) is refused, naming the file and the distance from `initpos`, not
+/// run to a solution of neither trajectory with exit 0.
+#[test]
+fn a_kf_gins_gnss_file_of_another_trajectory_is_refused() {
+    let d = scratch("foreign");
+    let sim = d.join("sim");
+    simulate_drive(&sim);
+    // The same drive's fixes, moved 20 km north: another trajectory at the same times.
+    let moved: String = std::fs::read_to_string(sim.join("gnss.txt"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let mut f: Vec<String> = l.split_whitespace().map(str::to_owned).collect();
+            let lat: f64 = f[1].parse().unwrap();
+            f[1] = format!("{:.11}", lat + 0.18);
+            f.join(" ") + "\n"
+        })
+        .collect();
+    std::fs::write(sim.join("gnss.txt"), moved).unwrap();
+    let o = bin()
+        .current_dir(&sim)
+        .args(["nav", "--kf-gins", "kf-gins.yaml"])
+        .output()
+        .unwrap();
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("gnss.txt") && err.contains("km from initpos") && err.contains("20.0 km"),
+        "{err}"
+    );
+    assert!(
+        !sim.join("kf-gins-out").exists(),
+        "outputs written for a refused run"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

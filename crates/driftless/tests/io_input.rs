@@ -213,12 +213,12 @@ fn a_log_at_two_rates_is_refused_naming_both_rates_and_where() {
             at,
             interval_s,
             other_interval_s,
-            end_line,
+            last,
             ..
         } => {
             assert!((interval_s - 0.02).abs() < 1e-9, "{msg}");
             assert!((other_interval_s - 0.01).abs() < 1e-9, "{msg}");
-            assert_eq!((at.line, *end_line), (Some(2), 3002), "{msg}");
+            assert_eq!((at.line, *last), (Some(2), 3002), "{msg}");
         }
         _ => panic!("{msg}"),
     }
@@ -358,5 +358,120 @@ fn configuration_files_are_read_under_a_size_cap() {
             .to_string()
             .contains("byte offset 6")
     );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A `DRIFTLOG` binary log holds its time column as written: a log at two rates (made
+/// in memory, as a converter of another format might) is refused when read back, naming
+/// the samples, not analysed at one τ0.
+#[test]
+fn a_binary_log_at_two_rates_is_refused_naming_the_samples() {
+    let mut t: Vec<f64> = uniform(3000, 0.01);
+    t.extend((1..=7000).map(|k| 29.99 + k as f64 * 0.02));
+    let n = t.len();
+    let log = ImuLog::new(
+        "two",
+        Some(t),
+        0.02,
+        vec![driftless::io::Channel {
+            name: "gx".into(),
+            quantity: driftless::io::Quantity::AngularRate,
+            source_unit: "rad/s".into(),
+            values: (0..n).map(|k| (k % 7) as f64 * 1e-3).collect(),
+        }],
+    );
+    let d = tmp("binrate");
+    let path = d.join("two.dlog");
+    write_binary_file(&log, &path).unwrap();
+    let e = read_log_file(&path, &TextOptions::default()).unwrap_err();
+    let msg = e.to_string();
+    match &e {
+        LogError::RateChange {
+            at, first, last, ..
+        } => {
+            assert_eq!((at.line, *first, *last), (None, 0, 2999), "{msg}");
+        }
+        _ => panic!("{msg}"),
+    }
+    assert!(
+        msg.contains("two.dlog")
+            && msg.contains("100 Hz")
+            && msg.contains("50 Hz")
+            && msg.contains("from sample 0 "),
+        "{msg}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The whole-file text readers (KF-GINS IMU and GNSS, RTKLIB `.pos` and `.tag`) end in an
+/// error within their first MiB on `/dev/zero` and on a file without line ends, and read a
+/// pipe through the one handle, giving what the file gives.
+#[cfg(unix)]
+#[test]
+fn whole_file_text_readers_are_bounded_and_read_pipes_once() {
+    use driftless::io::nav::{
+        FposSize, GnssReadOptions, read_kfgins_gnss_file, read_kfgins_imu_file,
+        read_rtklib_pos_file, read_rtklib_tag_file,
+    };
+    let d = tmp("whole");
+    let clock = std::time::Instant::now();
+    let zero = Path::new("/dev/zero");
+    let msgs = [
+        read_kfgins_imu_file(zero).unwrap_err().to_string(),
+        read_kfgins_gnss_file(zero, &GnssReadOptions::default())
+            .unwrap_err()
+            .to_string(),
+        read_rtklib_pos_file(zero, &GnssReadOptions::default())
+            .unwrap_err()
+            .to_string(),
+        read_rtklib_tag_file(zero, FposSize::Auto)
+            .unwrap_err()
+            .to_string(),
+    ];
+    for m in &msgs[..3] {
+        assert!(m.contains("/dev/zero: binary data"), "{m}");
+    }
+    assert!(msgs[3].contains("TIMETAG RTKLIB"), "{}", msgs[3]);
+    let long = d.join("long.txt");
+    std::fs::write(&long, vec![b'1'; 3 << 20]).unwrap();
+    let m = read_kfgins_gnss_file(&long, &GnssReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        m.contains("long.txt:1") && m.contains("longer than 1 MiB"),
+        "{m}"
+    );
+    assert!(clock.elapsed().as_secs_f64() < 5.0);
+
+    // A KF-GINS GNSS file through a FIFO: the same fixes as the file.
+    let text: String = (0..500)
+        .map(|k| {
+            format!(
+                "{:.3} 30.{:08} 114.3 20.0 0.02 0.02 0.04\n",
+                356400.0 + k as f64,
+                k * 7
+            )
+        })
+        .collect();
+    let file = d.join("gnss.txt");
+    std::fs::write(&file, &text).unwrap();
+    let fifo = d.join("gnss.fifo");
+    if mkfifo(&fifo).is_none() {
+        return;
+    }
+    let writer = {
+        let fifo = fifo.clone();
+        let bytes = text.clone().into_bytes();
+        std::thread::spawn(move || {
+            let mut f = std::fs::OpenOptions::new().write(true).open(fifo).unwrap();
+            f.write_all(&bytes).unwrap();
+        })
+    };
+    let through = read_kfgins_gnss_file(&fifo, &GnssReadOptions::default()).unwrap();
+    writer.join().unwrap();
+    let direct = read_kfgins_gnss_file(&file, &GnssReadOptions::default()).unwrap();
+    assert_eq!(through.time_s, direct.time_s);
+    assert_eq!(through.lat_rad, direct.lat_rad);
+    assert_eq!(through.len(), 500);
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -277,6 +277,7 @@ pub(crate) fn build_imu_log(
             });
         }
     };
+    super::timing::check_one_rate(&time_s, 1.5 * tau0_s, source)?;
     let gaps: Vec<TimeGap> = (1..time_s.len())
         .filter(|&i| time_s[i] - time_s[i - 1] > 1.5 * tau0_s)
         .map(|i| TimeGap {

@@ -461,6 +461,9 @@ fn read_impl<R: Read>(
             message: format!("time column not strictly increasing at row {}", i + 1),
         });
     }
+    if let Some(t) = &time_s {
+        super::timing::check_one_rate(t, 1.5 * h.tau0_s, source)?;
+    }
     let channels = h
         .channels
         .into_iter()

@@ -395,10 +395,10 @@ pub enum LogError {
     /// two sample rates. Refused, never averaged into one τ0.
     #[error(
         "{at}: the sample rate changes: {main} Hz (interval {dt} s) for most of the log, but \
-         {other} Hz (interval {other_dt} s) from line {start_line} (t = {t0} s) to line \
-         {end_line} (t = {t1} s) by the time column ({name}); an analysis needs one rate: cut \
+         {other} Hz (interval {other_dt} s) from {counted_as} {first} (t = {t0} s) to \
+         {counted_as} {last} (t = {t1} s) by the time stamps; an analysis needs one rate: cut \
          the log into parts of one rate each, or resample it",
-        start_line = at.line.unwrap_or(0),
+        counted_as = if at.line.is_some() { "line" } else { "sample" },
         main = crate::io::error::sig6(1.0 / *interval_s),
         dt = crate::io::error::sig6(*interval_s),
         other = crate::io::error::sig6(1.0 / *other_interval_s),
@@ -407,16 +407,17 @@ pub enum LogError {
         t1 = crate::io::error::sig6(*end_s)
     )]
     RateChange {
-        /// The stretch at the other rate: its first line.
+        /// The input; for a text log, at the stretch's first line.
         at: Location,
-        /// Time column name.
-        name: String,
         /// The interval of most of the log, s.
         interval_s: f64,
         /// The interval in the stretch, s.
         other_interval_s: f64,
-        /// Last line of the stretch.
-        end_line: usize,
+        /// First line of the stretch (text logs: `at`'s line), or its first 0-based sample
+        /// (binary and autopilot logs, which have no lines).
+        first: usize,
+        /// Last line or 0-based sample of the stretch, as `first`.
+        last: usize,
         /// Time at the stretch's first line, s.
         start_s: f64,
         /// Time at the stretch's last line, s.

@@ -296,6 +296,77 @@ pub(crate) fn human_bytes(n: u64) -> String {
     }
 }
 
+/// Longest line a whole-file text reader ([`read_text_input`]) accepts: 1 MiB, the
+/// default of [`TextOptions::max_line_bytes`].
+pub(crate) const MAX_TEXT_LINE_BYTES: usize = 1 << 20;
+
+/// Block read at a time by [`read_text_input`]: more than one line's cap, so the first
+/// block of a file without line ends already shows it.
+const TEXT_BLOCK_BYTES: usize = 2 << 20;
+
+/// Reads a whole text input (the KF-GINS and RTKLIB readers parse from memory) with the
+/// checks that keep a wrong input from filling the memory: binary data in the first
+/// [`SNIFF_BYTES`] is [`LogError::BinaryData`], and a line longer than
+/// [`MAX_TEXT_LINE_BYTES`] is [`LogError::LineTooLong`], found in the first block read.
+/// A regular file is then read whole (its size is known and its bytes are kept as rows);
+/// a pipe, FIFO or device is read through the same handle, block by block, every block
+/// checked the same way, so `/dev/zero` or an endless stream without line ends fails
+/// within the first MiB instead of growing without bound.
+pub(crate) fn read_text_input(
+    path: &Path,
+    read_regular: impl FnOnce(&Path) -> Result<Vec<u8>, LogError>,
+) -> Result<Vec<u8>, LogError> {
+    let name = path.display().to_string();
+    let io = |error| LogError::Io {
+        path: name.clone(),
+        error,
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let regular = file.metadata().map_err(io)?.is_file();
+    let mut bytes = Vec::new();
+    let mut line_start = 0usize;
+    let mut lines = 1usize;
+    loop {
+        let from = bytes.len();
+        let got = (&mut file)
+            .take(TEXT_BLOCK_BYTES as u64)
+            .read_to_end(&mut bytes)
+            .map_err(io)?;
+        let block = &bytes[from..];
+        if from == 0
+            && let Some(e) = binary_error(&block[..block.len().min(SNIFF_BYTES)], 0, &name)
+        {
+            return Err(e);
+        }
+        if !regular && let Some(i) = block.iter().position(|&b| b == 0) {
+            return Err(LogError::BinaryData {
+                path: name,
+                byte_offset: (from + i) as u64,
+                what: "a NUL byte".into(),
+            });
+        }
+        if let Some(i) = block.iter().rposition(|&b| b == b'\n') {
+            line_start = from + i + 1;
+            lines += block.iter().filter(|&&b| b == b'\n').count();
+        }
+        if bytes.len() - line_start > MAX_TEXT_LINE_BYTES {
+            return Err(LogError::LineTooLong {
+                at: Location::line(&name, lines),
+                limit: MAX_TEXT_LINE_BYTES,
+            });
+        }
+        if got < TEXT_BLOCK_BYTES {
+            return Ok(bytes);
+        }
+        if regular {
+            // The checks passed on the first block: the rest is read as the caller reads
+            // regular files (in parallel blocks for the large ones).
+            drop(bytes);
+            return read_regular(path);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1770,10 +1770,10 @@ fn time_analysis(
     if let Some(r) = rate_change(t, limit) {
         return Err(LogError::RateChange {
             at: Location::line(source, map.line_of(r.start)),
-            name,
             interval_s: r.interval_s,
             other_interval_s: r.other_interval_s,
-            end_line: map.line_of(r.end),
+            first: map.line_of(r.start),
+            last: map.line_of(r.end),
             start_s: t[r.start],
             end_s: t[r.end],
         });

@@ -97,6 +97,27 @@ pub(crate) fn rate_change(t: &[f64], gap_limit: f64) -> Option<RateStretch> {
     })
 }
 
+/// [`LogError::RateChange`] for a log without lines (binary and autopilot logs): the
+/// stretch named by its samples. `gap_limit` as in [`rate_change`].
+pub(crate) fn check_one_rate(
+    t: &[f64],
+    gap_limit: f64,
+    source: &str,
+) -> Result<(), super::error::LogError> {
+    match rate_change(t, gap_limit) {
+        None => Ok(()),
+        Some(r) => Err(super::error::LogError::RateChange {
+            at: super::error::Location::input(source),
+            interval_s: r.interval_s,
+            other_interval_s: r.other_interval_s,
+            first: r.start,
+            last: r.end,
+            start_s: t[r.start],
+            end_s: t[r.end],
+        }),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -115,10 +115,15 @@ fn required(
     match v {
         Some(p) => {
             let p = cfg.path(key, p);
-            if p.is_file() {
-                Ok(p)
-            } else {
-                Err(located(cfg, key, format!("{}: no such file", p.display())))
+            match std::fs::metadata(&p) {
+                // A pipe, FIFO or `/dev/stdin` is read once, as a file is.
+                Ok(m) if !m.is_dir() => Ok(p),
+                Ok(_) => Err(located(
+                    cfg,
+                    key,
+                    format!("{}: a folder, not a file", p.display()),
+                )),
+                Err(_) => Err(located(cfg, key, format!("{}: no such file", p.display()))),
             }
         }
         None => Err(NavJobError::Config(ConfigError {
@@ -280,6 +285,22 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
     let imu_path = required(cfg, "imu.file", &c.imu.file, "IMU")?;
     let gnss_path = required(cfg, "gnss.file", &c.gnss.file, "GNSS")?;
     let tag = c.imu.tag.as_ref().map(|t| cfg.path("imu.tag", t));
+    if c.imu.format == "auto"
+        && tag.is_none()
+        && std::fs::metadata(&imu_path).is_ok_and(|m| !m.is_file())
+    {
+        // Detection reads the first line; from a pipe those bytes would be gone for the
+        // reader.
+        return Err(located(
+            cfg,
+            "imu.format",
+            format!(
+                "{}: not a regular file (a pipe or device), so its format cannot be detected \
+                 without consuming it; set imu.format (--imu-format) to kfgins, csv or tagged-csv",
+                imu_path.display()
+            ),
+        ));
+    }
     let format = detect_imu_format(&c.imu.format, &imu_path, tag.is_some());
     let mut notes = Vec::new();
     // Everything that needs no data file is checked before the data are read.

@@ -185,6 +185,15 @@ pub enum KfGinsJobError {
         /// What is wrong and what to change.
         message: String,
     },
+    /// The GNSS file's position at the start disagrees with the configured initial
+    /// position: a GNSS file of another trajectory, or a wrong `initpos`.
+    #[error("{config}: {message}")]
+    InitialPosition {
+        /// Configuration file.
+        config: String,
+        /// What disagrees and what to check.
+        message: String,
+    },
     /// Creating the output folder.
     #[error("creating {path}: {error}")]
     CreateDir {
@@ -441,6 +450,7 @@ pub fn run_kf_gins_job(
         let sel = select_gnss(&gnss, &imu, &spec, GnssOutsideImu::Drop)?;
         cfg.outages_s = sel.windows.iter().map(|w| (w.start_s, w.end_s)).collect();
     }
+    check_initial_position(&k, &gnss, t_init, &cfg_name)?;
     let init = initial_state(&k, t_init);
 
     std::fs::create_dir_all(&k.output_dir).map_err(|error| KfGinsJobError::CreateDir {
@@ -479,6 +489,59 @@ pub fn run_kf_gins_job(
         notes,
         init,
         config: cfg,
+    })
+}
+
+/// Fixes within this many seconds of the start are compared with `initpos`.
+const INITPOS_CHECK_WINDOW_S: f64 = 5.0;
+
+/// Refuses a run whose GNSS fix nearest the start (within [`INITPOS_CHECK_WINDOW_S`]) lies
+/// farther from `initpos` than any consistent pair could: 500 m, plus five times the
+/// configured and the fix's horizontal σ, plus the distance the vehicle can cover in the
+/// time between them at the initial speed + 50 m/s. KF-GINS would start from `initpos`
+/// and be pulled to the other trajectory's fixes, a solution of neither.
+fn check_initial_position(
+    k: &KfGinsConfig,
+    gnss: &GnssFixes,
+    t_init: f64,
+    cfg_name: &str,
+) -> Result<(), KfGinsJobError> {
+    let Some(i) = (0..gnss.len())
+        .filter(|&i| (gnss.time_s[i] - t_init).abs() <= INITPOS_CHECK_WINDOW_S)
+        .min_by(|&a, &b| {
+            (gnss.time_s[a] - t_init)
+                .abs()
+                .total_cmp(&(gnss.time_s[b] - t_init).abs())
+        })
+    else {
+        return Ok(());
+    };
+    let d = crate::nav::earth::ned_offset_m(
+        (k.init_lat_rad, k.init_lon_rad, k.init_height_m),
+        (gnss.lat_rad[i], gnss.lon_rad[i], gnss.height_m[i]),
+    );
+    let horizontal_m = d[0].hypot(d[1]);
+    let sigma_h = |s: [f64; 3]| s[0].hypot(s[1]);
+    let v = k.init_vel_ned_m_s;
+    let speed = v[0].hypot(v[1]);
+    let dt = (gnss.time_s[i] - t_init).abs();
+    let allowed = 500.0
+        + 5.0 * (sigma_h(k.init_pos_std_ned_m) + sigma_h(gnss.sigma_ned_m[i]))
+        + dt * (speed + 50.0);
+    if horizontal_m.is_finite() && horizontal_m <= allowed {
+        return Ok(());
+    }
+    Err(KfGinsJobError::InitialPosition {
+        config: cfg_name.to_owned(),
+        message: format!(
+            "the GNSS fix at {} s in {} is {:.1} km from initpos (at most {:.1} km fits the \
+             σ and the time between them): the GNSS file belongs to another trajectory, or \
+             initpos is wrong; check gnsspath and initpos",
+            gnss.time_s[i],
+            k.gnss_path.display(),
+            horizontal_m / 1e3,
+            allowed / 1e3
+        ),
     })
 }
 

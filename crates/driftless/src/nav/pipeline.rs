@@ -880,7 +880,7 @@ pub fn imu_from_tagged_csv_files(
 ) -> Result<ImuStream, PipelineError> {
     let csv_path = csv_path.as_ref();
     let tag = read_rtklib_tag_file(tag_path, crate::io::nav::FposSize::Auto)?;
-    let bytes = crate::io::nav::read_file(csv_path)?;
+    let bytes = crate::io::nav::read_text_file(csv_path)?;
     imu_from_tagged_csv(&bytes, &csv_path.display().to_string(), &tag, opts)
 }
 
@@ -892,7 +892,7 @@ pub fn read_gnss_file(
     opts: &GnssReadOptions,
 ) -> Result<GnssFixes, PipelineError> {
     let path = path.as_ref();
-    let bytes = crate::io::nav::read_file(path)?;
+    let bytes = crate::io::nav::read_text_file(path)?;
     read_gnss(&bytes, &path.display().to_string(), opts)
 }
 

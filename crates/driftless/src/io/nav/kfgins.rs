@@ -38,8 +38,8 @@ use std::path::{Path, PathBuf};
 
 use super::types::{GnssFixes, ImuErrors, ImuIncrements, NavSolution, NavStd, common_len};
 use super::{
-    Field, as_utf8, check_time_order, parse_num, read_file, read_file_parallel, split_fields,
-    split_fields_into,
+    Field, as_utf8, check_time_order, parse_num, read_text_file, read_text_file_parallel,
+    split_fields, split_fields_into,
 };
 use crate::io::edge::{
     Edge, REFERENCE_SAMPLE, cut_record, last_data_line, line_of_offset, note, reference_count,
@@ -289,7 +289,7 @@ const IMU_NAMES: [&str; 7] = [
 /// Reads a KF-GINS IMU text file (see the module docs for the format).
 pub fn read_kfgins_imu_file(path: impl AsRef<Path>) -> Result<ImuIncrements, LogError> {
     let path = path.as_ref();
-    read_kfgins_imu(&read_file_parallel(path)?, &path.display().to_string())
+    read_kfgins_imu(&read_text_file_parallel(path)?, &path.display().to_string())
 }
 
 /// Reads KF-GINS IMU text from memory; `name` is used in error messages. Large inputs
@@ -543,7 +543,7 @@ pub fn read_kfgins_gnss_file(
     opts: &GnssReadOptions,
 ) -> Result<GnssFixes, LogError> {
     let path = path.as_ref();
-    read_kfgins_gnss(&read_file(path)?, &path.display().to_string(), opts)
+    read_kfgins_gnss(&read_text_file(path)?, &path.display().to_string(), opts)
 }
 
 /// Reads KF-GINS GNSS text from memory; `name` is used in error messages. Quality flags

@@ -48,6 +48,18 @@ pub(crate) fn read_file(path: &std::path::Path) -> Result<Vec<u8>, LogError> {
     })
 }
 
+/// A whole text file (KF-GINS, RTKLIB, tagged CSV) for the in-memory readers, with the
+/// binary-data and line-length checks of [`crate::io::input::read_text_input`]: `/dev/zero`
+/// or a file without line ends fails within its first MiB.
+pub(crate) fn read_text_file(path: &std::path::Path) -> Result<Vec<u8>, LogError> {
+    crate::io::input::read_text_input(path, read_file)
+}
+
+/// [`read_text_file`] reading a large regular file with [`read_file_parallel`].
+pub(crate) fn read_text_file_parallel(path: &std::path::Path) -> Result<Vec<u8>, LogError> {
+    crate::io::input::read_text_input(path, read_file_parallel)
+}
+
 /// Block size of [`read_file_parallel`], bytes.
 const READ_BLOCK_BYTES: usize = 4 << 20;
 

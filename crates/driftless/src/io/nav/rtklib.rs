@@ -36,7 +36,7 @@ use std::path::Path;
 use super::gpstime::{Calendar, GpsTime};
 use super::kfgins::{GnssReadOptions, check_lat_lon, check_sigma};
 use super::types::GnssFixes;
-use super::{Field, as_utf8, check_time_order, parse_num, read_file, split_fields};
+use super::{Field, as_utf8, check_time_order, parse_num, read_text_file, split_fields};
 use crate::io::edge::{Cut, Edge, cut_record, last_data_line, line_of_offset, note};
 use crate::io::{Location, LogError};
 
@@ -201,7 +201,7 @@ pub fn read_rtklib_pos_file(
     opts: &GnssReadOptions,
 ) -> Result<GnssFixes, LogError> {
     let path = path.as_ref();
-    read_rtklib_pos(&read_file(path)?, &path.display().to_string(), opts)
+    read_rtklib_pos(&read_text_file(path)?, &path.display().to_string(), opts)
 }
 
 /// Reads RTKLIB `.pos` text from memory; `name` is used in error messages. `time_s` is
@@ -403,6 +403,8 @@ pub struct TimeTag {
     pub fpos_size: FposSize,
 }
 
+/// The first bytes of every `.tag` file.
+const TAG_MAGIC: &[u8] = b"TIMETAG RTKLIB";
 /// Header size: 60 bytes of text + 4-byte tick.
 const TAG_HEADER: usize = 64;
 /// Header + 4-byte seconds + 8-byte fraction.
@@ -410,8 +412,25 @@ const TAG_BODY_START: usize = 76;
 
 /// Reads an RTKLIB `.tag` file.
 pub fn read_rtklib_tag_file(path: impl AsRef<Path>, fpos: FposSize) -> Result<TimeTag, LogError> {
+    use std::io::Read;
     let path = path.as_ref();
-    read_rtklib_tag(&read_file(path)?, &path.display().to_string(), fpos)
+    let name = path.display().to_string();
+    let io = |error| LogError::Io {
+        path: name.clone(),
+        error,
+    };
+    // The header first: anything without the magic (a wrong path, `/dev/zero`) is refused
+    // before the rest is read.
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    (&mut file)
+        .take(TAG_BODY_START as u64)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.starts_with(TAG_MAGIC) {
+        file.read_to_end(&mut bytes).map_err(io)?;
+    }
+    read_rtklib_tag(&bytes, &name, fpos)
 }
 
 fn u32_at(b: &[u8], off: usize) -> u32 {
@@ -456,14 +475,13 @@ pub fn read_rtklib_tag(bytes: &[u8], name: &str, fpos: FposSize) -> Result<TimeT
             ),
         });
     }
-    const MAGIC: &[u8] = b"TIMETAG RTKLIB";
-    if !bytes.starts_with(MAGIC) {
+    if !bytes.starts_with(TAG_MAGIC) {
         return Err(malformed(
             at(),
             FORMAT_TAG,
             format!(
                 "does not start with \"TIMETAG RTKLIB\" (found {:?})",
-                crate::io::error::excerpt(&bytes[..MAGIC.len()])
+                crate::io::error::excerpt(&bytes[..TAG_MAGIC.len()])
             ),
         ));
     }
