@@ -25,10 +25,10 @@ use std::time::Instant;
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     /// Hours of 100 Hz data per channel.
-    #[arg(long, default_value_t = 18.0)]
+    #[arg(long, default_value_t = 18.0, value_parser = crate::numbers::positive, allow_hyphen_values = true)]
     pub hours: f64,
     /// Repetitions per measurement.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = crate::numbers::count, allow_hyphen_values = true)]
     pub runs: usize,
     /// Where to write the generated logs (deleted afterwards unless --keep).
     #[arg(long, default_value = "/tmp/driftless-bench")]
@@ -86,7 +86,7 @@ fn allan_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
         rate_random_walk: 1e-6,
         ..StaticNoiseConfig::default()
     };
-    eprintln!("generating 6 × {n} samples …");
+    note!("generating 6 × {n} samples …");
     let data = generate_channels(&vec![cfg; 6], 7)?;
     let names = ["gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z"];
     let channels: Vec<Channel> = names
@@ -116,7 +116,7 @@ fn allan_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
         let csv = a.dir.join("static_18h.csv");
         let csv_full = a.dir.join("static_18h_full.csv");
         let bin = a.dir.join("static_18h.dlog");
-        eprintln!(
+        note!(
             "writing {}, {} and {} …",
             csv.display(),
             csv_full.display(),

@@ -42,7 +42,7 @@ pub enum Method {
 #[derive(Args, Debug)]
 pub struct Common {
     /// Gravity magnitude, m/s² (default: normal gravity at --lat-deg / --height-m).
-    #[arg(long, value_name = "M_S2")]
+    #[arg(long, value_name = "M_S2", value_parser = crate::numbers::positive, allow_hyphen_values = true)]
     pub gravity: Option<f64>,
     /// Site latitude for normal gravity, deg.
     #[arg(long, default_value_t = 45.0, allow_hyphen_values = true)]
@@ -73,7 +73,7 @@ pub struct MultiArgs {
     /// Gyro raw scale guess, rad/s per raw unit, within ±20 % (e.g. 1.6e-4 for 16-bit
     /// counts at ±300 deg/s; 1 for a log in rad/s). Default: found from the data (the
     /// tilts between poses against the integrated raw gyro).
-    #[arg(long, value_name = "RAD_S_PER_RAW")]
+    #[arg(long, value_name = "RAD_S_PER_RAW", value_parser = crate::numbers::positive, allow_hyphen_values = true)]
     pub gyro_scale_guess: Option<f64>,
     /// Keep a result whose own quality figures are implausible (gravity direction after
     /// integrating the gyro beyond 3° RMS, or |a| − g far above its noise) instead of

@@ -55,7 +55,7 @@ pub fn run(a: ConvertArgs) -> Result<()> {
         LogFormat::Binary => driftless::io::write_binary_file(&log, &a.output),
     }
     .with_context(|| format!("writing {}", a.output.display()))?;
-    eprintln!(
+    note!(
         "{} → {}: {} channels × {} samples",
         a.input.display(),
         a.output.display(),

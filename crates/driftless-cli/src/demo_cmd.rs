@@ -52,9 +52,10 @@ pub struct DemoArgs {
     pub json: bool,
 }
 
-/// A spinner on stderr (hidden when not a terminal or when `show` is false).
+/// A spinner on stderr (hidden when not a terminal, when `show` is false, or with
+/// `--quiet`).
 pub fn spinner(show: bool, msg: String) -> ProgressBar {
-    if !show {
+    if !show || crate::verbosity::quiet() {
         return ProgressBar::hidden();
     }
     let pb = ProgressBar::new_spinner();

@@ -66,7 +66,7 @@ pub fn run_scenario(
         show,
         "noise stage: static log → Allan deviation → noise model".into(),
     );
-    let runs_bar = if show {
+    let runs_bar = if show && !crate::verbosity::quiet() {
         let b = ProgressBar::new(k as u64);
         b.set_style(
             ProgressStyle::with_template(

@@ -12,10 +12,10 @@ use std::path::Path;
 #[derive(Args, Debug, Clone)]
 pub struct InputArgs {
     /// IMU instance to take from a PX4 ULog (`.ulg`) or ArduPilot DataFlash (`.bin`) log.
-    #[arg(long, value_name = "N", default_value_t = 0)]
+    #[arg(long, value_name = "N", default_value_t = 0, value_parser = crate::numbers::whole::<u8>, allow_hyphen_values = true)]
     pub instance: u8,
     /// Sample rate in Hz (required when the file has no time column).
-    #[arg(long, value_name = "HZ", allow_hyphen_values = true)]
+    #[arg(long, value_name = "HZ", value_parser = crate::numbers::positive, allow_hyphen_values = true)]
     pub rate: Option<f64>,
     /// Time column, by 1-based number or header name. Omitted: a header field named t,
     /// time, timestamp, time_s, stamp, sec, seconds, gps_time, gpst or time_stamp (any case,
@@ -46,8 +46,8 @@ pub struct InputArgs {
     /// straddles a gap) or bridge (treat the data as contiguous).
     #[arg(long, default_value = "error")]
     pub gaps: String,
-    /// An interval longer than this many nominal sample intervals is a gap.
-    #[arg(long, default_value_t = 1.5)]
+    /// An interval longer than this many nominal sample intervals is a gap (> 1).
+    #[arg(long, default_value_t = 1.5, value_parser = crate::numbers::above_one, allow_hyphen_values = true)]
     pub gap_factor: f64,
 }
 
@@ -67,11 +67,6 @@ impl InputArgs {
             rate_hz: self.rate,
             ..TextOptions::default()
         };
-        if let Some(r) = self.rate
-            && !(r.is_finite() && r > 0.0)
-        {
-            anyhow::bail!("--rate must be a positive number of Hz, got {r}");
-        }
         if self
             .time_column
             .as_deref()
@@ -118,7 +113,7 @@ impl InputArgs {
             anyhow::bail!("{}: no data rows", path.display());
         }
         for n in &log.notes {
-            eprintln!("note: {n}");
+            note!("note: {n}");
         }
         Ok(log)
     }
@@ -134,7 +129,8 @@ fn parse_time_unit(s: &str) -> Result<TimeUnit> {
     })
 }
 
-/// Reads one IMU instance of an autopilot log, telling on stderr what the log holds.
+/// Reads one IMU instance of an autopilot log, telling on stderr what the log holds
+/// (notes, silenced by `--quiet`; a truncated log is a warning).
 #[cfg(feature = "autopilot-logs")]
 fn read_autopilot(input: LogInput, instance: u8) -> Result<ImuLog> {
     let path = std::path::PathBuf::from(input.name());
@@ -148,7 +144,7 @@ fn read_autopilot(input: LogInput, instance: u8) -> Result<ImuLog> {
         })
         .map(|(n, c)| format!("{n} ×{c}"))
         .collect();
-    eprintln!(
+    note!(
         "{}: {}, {} topics/message types; IMU data: {}",
         path.display(),
         all.format.name(),
@@ -169,7 +165,7 @@ fn read_autopilot(input: LogInput, instance: u8) -> Result<ImuLog> {
                 format!(", temperature {lo:.2}–{hi:.2} °C")
             })
             .unwrap_or_default();
-        eprintln!(
+        note!(
             "  instance {}: {} samples, τ0 = {:.4} s, channels {}{span}{}",
             imu.instance,
             l.len(),
@@ -187,10 +183,13 @@ fn read_autopilot(input: LogInput, instance: u8) -> Result<ImuLog> {
         );
     }
     if let Some(at) = all.truncated_at_byte {
-        eprintln!("  log truncated: stopped cleanly at the message cut off at byte {at}");
+        eprintln!(
+            "warning: {}: log truncated: stopped cleanly at the message cut off at byte {at}",
+            path.display()
+        );
     }
     for n in &all.notes {
-        eprintln!("  note: {n}");
+        note!("  note: {n}");
     }
     let available: Vec<String> = all.imus.iter().map(|i| i.instance.to_string()).collect();
     let Some(pos) = all.imus.iter().position(|i| i.instance == instance) else {

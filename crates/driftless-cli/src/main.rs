@@ -4,39 +4,70 @@
 //! `experiment` (the seed paper's experiment end to end), `demo` (the experiment on
 //! built-in simulated data; `--noise`: the Allan demo), `bench`, `nav` (GNSS/INS),
 //! `simulate` (scenario → IMU, GNSS and truth files), `calibrate`, `thermal`,
-//! `compensate`.
+//! `compensate`, and `completions` / `man` (shell completion scripts and man pages).
+//!
+//! Standard output carries only the result (tables or JSON); errors, warnings, notes and
+//! progress bars go to standard error ([`verbosity`]). Exit status: 0 success, 1 error,
+//! 2 usage error ([`EXIT_CODES`]).
 
 #[macro_use]
 mod stdout;
+#[macro_use]
+mod verbosity;
 
 mod allan_cmd;
 mod bench_cmd;
 mod calibrate_cmd;
 mod compensate_cmd;
+mod completions_cmd;
 mod convert_cmd;
 mod demo_cmd;
 mod experiment_cmd;
 mod input;
+mod man_cmd;
 mod nav_cmd;
+mod numbers;
 mod output;
 mod paths;
 mod segment_view;
 mod simulate_cmd;
 mod thermal_cmd;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
+
+/// The exit statuses, as `--help` and the man page state them.
+pub const EXIT_CODES: &str = "\
+Exit status:
+  0  success: the result was printed and every output file written
+  1  error: the result cannot be stood behind (unreadable or bad input, a check that
+     failed, an output that could not be written); the message on stderr names the
+     file, line or time span and what to change
+  2  usage error: an unknown command or flag, a missing or malformed argument
+
+Standard output carries only the result (tables or JSON); errors, warnings, notes and
+progress bars go to standard error. --quiet leaves errors and the warnings the result
+depends on; --verbose adds detail where a command has it.";
 
 #[derive(Parser)]
 #[command(
     name = "driftless",
     version,
     about = "MEMS IMU noise analysis, calibration and GNSS/INS error budgets",
-    propagate_version = true
+    propagate_version = true,
+    after_long_help = EXIT_CODES
 )]
-struct Cli {
+pub struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// No notes or progress bars on stderr (errors and the warnings the result depends
+    /// on are still printed).
+    #[arg(long, short = 'q', global = true, conflicts_with = "verbose")]
+    quiet: bool,
+    /// More detail on stderr where a command has it (every rejected GNSS fix, every IMU
+    /// value finding).
+    #[arg(long, short = 'v', global = true)]
+    verbose: bool,
 }
 
 #[derive(Subcommand)]
@@ -65,10 +96,21 @@ enum Command {
     Experiment(experiment_cmd::ExperimentArgs),
     /// The experiment on the built-in adi-like scenario (`--noise`: the Allan demo).
     Demo(demo_cmd::DemoArgs),
+    /// Print a shell completion script (bash, zsh or fish).
+    Completions(completions_cmd::CompletionsArgs),
+    /// Print the man page (roff), or write one page per command into a folder.
+    Man(man_cmd::ManArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    verbosity::set(if cli.quiet {
+        verbosity::Verbosity::Quiet
+    } else if cli.verbose {
+        verbosity::Verbosity::Verbose
+    } else {
+        verbosity::Verbosity::Normal
+    });
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         run(cli.command)?;
         stdout::flush().map_err(|e| anyhow::Error::new(stdout::StdoutFailed(e)))
@@ -105,6 +147,8 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::Nav(a) => nav_cmd::run(a),
         Command::Simulate(a) => simulate_cmd::run(a),
         Command::Thermal(a) => thermal_cmd::run(a),
+        Command::Completions(a) => completions_cmd::run(a, Cli::command()),
+        Command::Man(a) => man_cmd::run(a, Cli::command()),
     }
 }
 
@@ -123,4 +167,17 @@ fn error_chain(e: &anyhow::Error) -> String {
         msg.push_str(&text);
     }
     msg
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// clap's own consistency checks of the definition (no two flags with one short
+    /// name, a global flag that a subcommand does not shadow, …), which a release
+    /// build skips.
+    #[test]
+    fn command_line_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
 }

@@ -135,12 +135,6 @@ pub struct NavArgs {
     /// Machine-readable summary.
     #[arg(long)]
     pub json: bool,
-    /// No notes on stderr (results and errors only).
-    #[arg(long, short = 'q', conflicts_with = "verbose")]
-    pub quiet: bool,
-    /// Every note, and every rejected GNSS fix.
-    #[arg(long, short = 'v')]
-    pub verbose: bool,
     /// The configuration keys as flags.
     #[command(flatten)]
     pub settings: ConfigFlags,
@@ -229,21 +223,24 @@ pub fn run(a: NavArgs) -> Result<()> {
         }
         Err(e) => return Err(e.into()),
     };
-    let note = |m: &str| {
-        if !a.quiet {
-            eprintln!("note: {m}");
-        }
-    };
+    let note = |m: &str| note!("note: {m}");
     for n in &job.notes {
         note(n);
     }
     // Bad IMU values are warnings even with --quiet: the result depends on them.
-    warn_imu_findings(&job.imu_check, if a.verbose { usize::MAX } else { 20 });
+    warn_imu_findings(
+        &job.imu_check,
+        if crate::verbosity::verbose() {
+            usize::MAX
+        } else {
+            20
+        },
+    );
     let res = &job.session;
     let run = &res.run;
-    if a.verbose {
+    if crate::verbosity::verbose() {
         log_rejections(run, usize::MAX);
-    } else if !a.quiet && run.gnss_rejected > 0 {
+    } else if !crate::verbosity::quiet() && run.gnss_rejected > 0 {
         let worst = run.rejections().map(|o| o.nis).fold(0.0f64, f64::max);
         let first = run.rejections().next().map_or(f64::NAN, |o| o.time_s);
         note(&format!(
@@ -334,7 +331,7 @@ pub fn run(a: NavArgs) -> Result<()> {
         job.dropped_by_quality
     );
     if sc.auto_sigma_floor {
-        println!("{}", floor_summary(&res.sigma_floors));
+        outln!("{}", floor_summary(&res.sigma_floors));
     }
     let ic = &job.imu_check;
     if !ic.findings.is_empty() {
@@ -520,7 +517,7 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
         keep_records: a.csv.is_some() || a.geojson.is_some(),
     };
     let job = run_kf_gins_job(path, &opts)?;
-    if !a.quiet {
+    if !crate::verbosity::quiet() {
         for n in &job.notes {
             eprintln!("note: {n}");
         }
@@ -528,8 +525,15 @@ fn run_kf_gins(path: &std::path::Path, a: &NavArgs) -> Result<()> {
             eprint!("{}", selection_table(sel));
         }
     }
-    if !a.quiet {
-        log_rejections(&job.run, if a.verbose { usize::MAX } else { 20 });
+    if !crate::verbosity::quiet() {
+        log_rejections(
+            &job.run,
+            if crate::verbosity::verbose() {
+                usize::MAX
+            } else {
+                20
+            },
+        );
     }
     if let Some((sol, _, _)) = (a.csv.is_some() || a.geojson.is_some())
         .then(|| job.solution())

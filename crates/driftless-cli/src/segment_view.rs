@@ -16,15 +16,15 @@ use std::path::Path;
 pub struct SegmentArgs {
     /// Without a manifest: the rate table's |ω|, deg/s (default: the measured rate
     /// rounded to 5 deg/s, reported as a finding).
-    #[arg(long, value_name = "DEG_S")]
+    #[arg(long, value_name = "DEG_S", value_parser = crate::numbers::positive, allow_hyphen_values = true)]
     pub table_rate_deg_s: Option<f64>,
     /// Without a manifest: largest angle between a static reading and a body axis for a
     /// position, deg.
-    #[arg(long, default_value_t = 15.0)]
+    #[arg(long, default_value_t = 15.0, value_parser = crate::numbers::positive, allow_hyphen_values = true)]
     pub orientation_tolerance_deg: f64,
     /// Without a manifest: largest temperature span over a plateau's positions and
     /// rotations for it to count as settled, °C.
-    #[arg(long, default_value_t = 0.2)]
+    #[arg(long, default_value_t = 0.2, value_parser = crate::numbers::positive, allow_hyphen_values = true)]
     pub settled_band_c: f64,
 }
 

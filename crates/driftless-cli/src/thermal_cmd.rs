@@ -48,10 +48,10 @@ pub struct CheckArgs {
     /// instance is checked).
     pub log: PathBuf,
     /// Polynomial order the model will have (sets how many levels/plateaus are needed).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = crate::numbers::whole::<usize>, allow_hyphen_values = true)]
     pub order: usize,
     /// Smallest temperature rise a model needs, °C.
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, value_parser = crate::numbers::non_negative, allow_hyphen_values = true)]
     pub min_rise: f64,
     /// Machine-readable output.
     #[arg(long)]
@@ -71,7 +71,7 @@ pub struct ExportArgs {
     #[arg(long, value_name = "FILE.param")]
     pub ardupilot: Option<PathBuf>,
     /// Sensor instance: PX4 TC_A<N>/TC_G<N> (0-3), ArduPilot INS_TCAL<N+1> (0-2).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = crate::numbers::whole::<usize>, allow_hyphen_values = true)]
     pub instance: usize,
     /// Only the temperature dependence: no room offsets (PX4 X0 = 0 and no CAL_*OFF;
     /// ArduPilot no INS_*OFFS / CALTEMP), the vehicle's own calibration stays.
@@ -95,17 +95,17 @@ pub struct RampArgs {
     /// (`IMU`) log, recognised by its magic bytes (pick the IMU with `--instance N`).
     pub log: PathBuf,
     /// Polynomial order, 1–5.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = crate::numbers::whole::<usize>, allow_hyphen_values = true)]
     pub order: usize,
     /// Reference temperature, °C.
     #[arg(long, default_value_t = 25.0, allow_hyphen_values = true)]
     pub t_ref: f64,
     /// Temperature bin width, °C.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = crate::numbers::positive, allow_hyphen_values = true)]
     pub bin: f64,
     /// Smallest temperature rise the log must show, °C (the checks of `thermal check`
     /// run first and refuse a log that cannot give a model).
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, value_parser = crate::numbers::non_negative, allow_hyphen_values = true)]
     pub min_rise: f64,
     /// Write a bias-only compensation model file here (TOML): matrix I, no scale terms,
     /// gyro bias = fit at T_ref, accelerometer bias 0 (not separable from gravity).
@@ -135,12 +135,12 @@ pub struct SoakArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub height_m: Option<f64>,
     /// Without a manifest: gravity magnitude, m/s² (default: normal gravity at the site).
-    #[arg(long, value_name = "M_S2")]
+    #[arg(long, value_name = "M_S2", value_parser = crate::numbers::positive, allow_hyphen_values = true)]
     pub gravity: Option<f64>,
     #[command(flatten)]
     pub segment: crate::segment_view::SegmentArgs,
     /// Polynomial order, 1–5.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = crate::numbers::whole::<usize>, allow_hyphen_values = true)]
     pub order: usize,
     /// Reference temperature, °C.
     #[arg(long, default_value_t = 25.0, allow_hyphen_values = true)]
@@ -152,7 +152,7 @@ pub struct SoakArgs {
     #[arg(long, value_name = "FILE.toml")]
     pub noise_model: Option<PathBuf>,
     /// Smallest span of the set temperatures, °C.
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, value_parser = crate::numbers::non_negative, allow_hyphen_values = true)]
     pub min_rise: f64,
     /// Outside the soaked range: clamp, extrapolate or error.
     #[arg(long, default_value = "clamp")]
@@ -630,7 +630,7 @@ fn ramp(r: RampArgs) -> Result<()> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
             (a.min(x), b.max(x))
         });
-    eprintln!(
+    note!(
         "{}: {} samples over {:.1} s, temperature {t_lo:.2}–{t_hi:.2} °C (span {:.2} °C)",
         r.log.display(),
         log.len(),

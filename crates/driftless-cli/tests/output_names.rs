@@ -111,9 +111,13 @@ fn a_negative_rate_is_a_value_not_a_flag() {
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "a bad flag value is a usage error: {err}"
+    );
     assert!(
-        err.contains("--rate must be a positive number of Hz, got -100"),
+        err.contains("'--rate <HZ>': must be a positive number, got -100"),
         "{err}"
     );
     let _ = std::fs::remove_dir_all(&d);
