@@ -209,6 +209,24 @@ fn multi(m: MultiArgs) -> Result<()> {
                     gl.len()
                 );
             }
+            // Sampled together means at the same instants: a file's own time stamps are
+            // not set aside for its row order.
+            if let (Some(ta), Some(tg)) = (&acc_log.time_s, &gl.time_s) {
+                let tol = 0.5 * acc_log.tau0_s.min(gl.tau0_s);
+                if let Some(i) = ta.iter().zip(tg).position(|(a, b)| !((a - b).abs() <= tol)) {
+                    bail!(
+                        "{} and {} are not sampled together: sample {} is at t = {} s in the \
+                         first and t = {} s in the second (more than half a sample interval \
+                         apart); give files recorded at the same instants, or one file with \
+                         both triads",
+                        m.accel.display(),
+                        p.display(),
+                        i + 1,
+                        ta[i],
+                        tg[i]
+                    );
+                }
+            }
             (
                 triad(&acc_log, Quantity::SpecificForce, 0, "accelerometer")?,
                 triad(&gl, Quantity::AngularRate, 0, "gyro")?,

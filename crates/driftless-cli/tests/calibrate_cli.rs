@@ -238,3 +238,42 @@ fn multi_position_without_a_guess_and_a_poor_fit() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("warning: gyro fit"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Gyro and accelerometer files must be sampled at the same instants, not merely hold as
+/// many rows: the imu_tk gyro file with its time stamps shifted by 0.5 s is refused,
+/// naming both files and the first sample that differs.
+#[test]
+#[ignore = "needs shared data"]
+fn multi_position_refuses_files_sampled_at_other_instants() {
+    let d = data_dir().join("calib/imu_tk_xsens");
+    let dir = std::env::temp_dir().join(format!("driftless-calshift-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let shifted: String = std::fs::read_to_string(d.join("xsens_gyro.txt"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let mut f = l.split_whitespace();
+            let t: f64 = f.next().unwrap().parse().unwrap();
+            let rest: Vec<&str> = f.collect();
+            format!("{:.7e} {}\n", t + 0.5, rest.join(" "))
+        })
+        .collect();
+    let gyro = dir.join("gyro_shifted.txt");
+    std::fs::write(&gyro, shifted).unwrap();
+    let out = bin()
+        .args(["calibrate", "multi-position", "--gravity", "9.81744"])
+        .arg(d.join("xsens_acc.txt"))
+        .arg(&gyro)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("xsens_acc.txt")
+            && err.contains("gyro_shifted.txt")
+            && err.contains("not sampled together")
+            && err.contains("sample 1 "),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -651,3 +651,54 @@ fn convert_a_truncated_dataflash_log_to_csv() {
     assert!(rows[1].ends_with(",28.5"), "{}", rows[1]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A warm-up log whose samples are subnormal (near 1e-310) is fitted with uncertainties
+/// in proportion to its values, never exactly zero from squares that underflow.
+#[test]
+fn ramp_on_subnormal_samples_keeps_its_uncertainties() {
+    let dir = std::env::temp_dir().join(format!("driftless-rampsub-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    simulate(
+        &dir,
+        "sim",
+        "seed = 3\n[imu]\nrate_hz = 100.0\npreset = \"consumer\"\noutput = \"rates\"\n\
+         [trajectory]\ntype = \"static\"\nlat_deg = 45.0\nduration_s = 900.0\n\
+         [temperature]\nkind = \"warm_up\"\nt0_c = 20.0\nt1_c = 50.0\ntau_s = 250.0\n",
+    );
+    let text = std::fs::read_to_string(dir.join("sim/imu.csv")).unwrap();
+    let tiny: String = text
+        .lines()
+        .map(|l| {
+            if !l.starts_with(|c: char| c.is_ascii_digit()) {
+                return format!("{l}\n");
+            }
+            let f: Vec<String> = l
+                .split(',')
+                .enumerate()
+                .map(|(k, v)| match k {
+                    1..=6 => format!("{:e}", v.parse::<f64>().unwrap() * 1e-310),
+                    _ => v.to_owned(),
+                })
+                .collect();
+            f.join(",") + "\n"
+        })
+        .collect();
+    std::fs::write(dir.join("tiny.csv"), tiny).unwrap();
+    let v = run_json(
+        bin()
+            .args(["thermal", "ramp", "--json"])
+            .arg(dir.join("tiny.csv")),
+    );
+    for f in v["fits"].as_array().unwrap() {
+        let se: Vec<f64> = f["std_errors"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_f64().unwrap())
+            .collect();
+        assert!(se.iter().all(|&s| s > 0.0), "{}: {se:?}", f["channel"]);
+        assert!(f["residual_rms"].as_f64().unwrap() > 0.0, "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

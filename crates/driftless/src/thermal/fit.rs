@@ -615,7 +615,57 @@ fn cholesky(c: &[f64], n: usize) -> Option<Vec<f64>> {
     Some(l)
 }
 
+/// Data whose largest magnitude lies outside 2^±[`SAFE_EXPONENT`] are fitted scaled by a
+/// power of two (exact in binary floating point) and the results scaled back: squares of
+/// residuals near 1e-310 underflow to zero (an uncertainty of exactly 0), those near 1e160
+/// overflow.
+const SAFE_EXPONENT: i32 = 300;
+
 fn fit_impl(
+    t_c: &[f64],
+    y: &[f64],
+    sigma: Option<&[f64]>,
+    chol: Option<&[f64]>,
+    opts: &FitOptions,
+) -> Result<ThermalFit, ThermalFitError> {
+    let largest = y.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    if !(largest.is_finite() && largest > 0.0) {
+        return fit_unscaled(t_c, y, sigma, chol, opts);
+    }
+    let exponent = largest.log2().round() as i32;
+    if exponent.abs() <= SAFE_EXPONENT {
+        return fit_unscaled(t_c, y, sigma, chol, opts);
+    }
+    // y / 2^e, in two steps so that neither factor leaves the normal range.
+    let down = |v: f64| v * 2f64.powi(-exponent / 2) * 2f64.powi(-(exponent - exponent / 2));
+    let up = |v: f64| v * 2f64.powi(exponent / 2) * 2f64.powi(exponent - exponent / 2);
+    let ys: Vec<f64> = y.iter().map(|&v| down(v)).collect();
+    let sigmas: Option<Vec<f64>> = sigma.map(|s| s.iter().map(|&v| down(v)).collect());
+    let chols: Option<Vec<f64>> = chol.map(|l| l.iter().map(|&v| down(v)).collect());
+    let mut f = fit_unscaled(t_c, &ys, sigmas.as_deref(), chols.as_deref(), opts)?;
+    for c in f
+        .coeffs
+        .iter_mut()
+        .chain(&mut f.coeffs_scaled)
+        .chain(&mut f.std_errors)
+    {
+        *c = up(*c);
+    }
+    for c in f.covariance.iter_mut().chain(&mut f.cov_scaled) {
+        *c = up(up(*c));
+    }
+    f.residual_rms = up(f.residual_rms);
+    if sigma.is_none() {
+        // Without given σ the noise scale is the residual scatter, in the data's unit.
+        f.sigma_scale = up(f.sigma_scale);
+    }
+    let (t_min, t_max) = f.poly.range_c();
+    f.poly =
+        ThermalPoly::new(opts.t_ref_c, &f.coeffs, t_min, t_max).map_err(ThermalFitError::Poly)?;
+    Ok(f)
+}
+
+fn fit_unscaled(
     t_c: &[f64],
     y: &[f64],
     sigma: Option<&[f64]>,
@@ -1060,6 +1110,38 @@ pub fn advise_order(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Data near 1e-301 (and near 1e+301) give the fit of the same data near 1, scaled:
+    /// no uncertainty lost to underflowing squares, none overflowing.
+    #[test]
+    fn tiny_and_huge_data_keep_their_uncertainties() {
+        let t: Vec<f64> = (0..30).map(|k| 5.0 + 1.5 * k as f64).collect();
+        let y: Vec<f64> = t
+            .iter()
+            .enumerate()
+            .map(|(k, &x)| 0.3 + 0.01 * x - 2e-4 * x * x + 1e-3 * ((k * 7 % 11) as f64 - 5.0))
+            .collect();
+        let opts = FitOptions {
+            order: 2,
+            ..FitOptions::default()
+        };
+        let base = fit(&t, &y, None, &opts).unwrap();
+        assert!(base.std_errors.iter().all(|&s| s > 0.0));
+        for e in [-1000, 1000] {
+            let k = 2f64.powi(e);
+            let ys: Vec<f64> = y.iter().map(|v| v * k).collect();
+            let f = fit(&t, &ys, None, &opts).unwrap();
+            let close = |a: f64, b: f64| (a - b * k).abs() <= 1e-12 * (b * k).abs();
+            for (a, b) in f.std_errors.iter().zip(&base.std_errors) {
+                assert!(close(*a, *b), "2^{e}: σ {a:e} vs {b:e}");
+            }
+            for (a, b) in f.coeffs.iter().zip(&base.coeffs) {
+                assert!(close(*a, *b), "2^{e}: c {a:e} vs {b:e}");
+            }
+            assert!(close(f.residual_rms, base.residual_rms));
+            assert!(close(f.sigma_scale, base.sigma_scale));
+        }
+    }
 
     #[test]
     fn binomials() {

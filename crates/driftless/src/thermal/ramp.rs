@@ -135,8 +135,16 @@ fn robust_mean_and_se(v: &mut [f64]) -> (f64, f64) {
         .collect();
     let k = kept.len().max(1) as f64;
     let m = kept.iter().sum::<f64>() / k;
-    let var = kept.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (k - 1.0).max(1.0);
-    (m, (var / k).sqrt())
+    // The deviations scaled by a power of two near the largest (exact), so that their
+    // squares neither underflow (data near 1e-310 would get σ = 0) nor overflow.
+    let spread = kept.iter().fold(0.0f64, |a, x| a.max((x - m).abs()));
+    let unit = if spread > 0.0 && spread.is_finite() {
+        2f64.powi(spread.log2().floor() as i32)
+    } else {
+        1.0
+    };
+    let var = kept.iter().map(|x| ((x - m) / unit).powi(2)).sum::<f64>() / (k - 1.0).max(1.0);
+    (m, (var / k).sqrt() * unit)
 }
 
 /// Bias versus temperature from a ramp (module docs). `channels` are (name, samples),
