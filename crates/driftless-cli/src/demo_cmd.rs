@@ -27,8 +27,8 @@ pub struct DemoArgs {
     #[arg(long, default_value = "driftless-demo")]
     pub out: PathBuf,
     /// Write into an output folder that already holds files: this run's files replace
-    /// theirs, and figures an earlier run wrote that this run does not are removed.
-    /// Without it such a folder is refused, so that runs never mix.
+    /// theirs (the experiment also removes figures an earlier run wrote that this one
+    /// does not). Without it such a folder is refused, so that runs never mix.
     #[arg(long)]
     pub force: bool,
     /// Monte Carlo runs of the experiment (default: the built-in scenario's 20).
