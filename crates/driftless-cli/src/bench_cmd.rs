@@ -111,8 +111,9 @@ fn allan_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
     let time: Vec<f64> = (0..n).map(|i| i as f64 / rate).collect();
     let log = ImuLog::new("bench", Some(time), 1.0 / rate, channels);
 
+    // Held while the benchmark writes and reads its files: a second run would race them.
+    let _lock = driftless::io::output::lock_folder(&a.dir)?;
     if !a.no_io {
-        std::fs::create_dir_all(&a.dir).with_context(|| format!("creating {}", a.dir.display()))?;
         let csv = a.dir.join("static_18h.csv");
         let csv_full = a.dir.join("static_18h_full.csv");
         let bin = a.dir.join("static_18h.dlog");

@@ -26,6 +26,11 @@ pub struct DemoArgs {
     /// Output folder.
     #[arg(long, default_value = "driftless-demo")]
     pub out: PathBuf,
+    /// Write into an output folder that already holds files: this run's files replace
+    /// theirs (the experiment also removes figures an earlier run wrote that this one
+    /// does not). Without it such a folder is refused, so that runs never mix.
+    #[arg(long)]
+    pub force: bool,
     /// Monte Carlo runs of the experiment (default: the built-in scenario's 20).
     #[arg(long)]
     pub runs: Option<usize>,
@@ -108,14 +113,19 @@ pub fn run(a: DemoArgs) -> Result<()> {
     }
     if !a.noise {
         let sc = driftless::experiment::ExperimentScenario::builtin_adi_like()?;
-        return crate::experiment_cmd::run_scenario(sc, &a.out, a.runs, a.json);
+        let out = crate::experiment_cmd::OutputFolder {
+            dir: &a.out,
+            force: a.force,
+        };
+        return crate::experiment_cmd::run_scenario(sc, out, a.runs, a.json);
     }
     noise_demo(a)
 }
 
 fn noise_demo(a: DemoArgs) -> Result<()> {
     let t_all = Instant::now();
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    // Held until the last file is written.
+    let _lock = driftless::io::output::claim_folder(&a.out, a.force)?;
     let duration_s = a.hours * 3600.0;
     let truth = demo_truth(a.rate, duration_s);
     let n = (duration_s * a.rate).round() as usize;

@@ -24,6 +24,11 @@ pub struct ExperimentArgs {
     /// Output folder.
     #[arg(long, default_value = "driftless-experiment")]
     pub out: PathBuf,
+    /// Write into an output folder that already holds files: this run's files replace
+    /// theirs, and figures an earlier run wrote that this run does not are removed.
+    /// Without it such a folder is refused, so that runs never mix.
+    #[arg(long)]
+    pub force: bool,
     /// Monte Carlo runs (default: the scenario's `[monte_carlo] runs`).
     #[arg(long)]
     pub runs: Option<usize>,
@@ -32,14 +37,26 @@ pub struct ExperimentArgs {
     pub json: bool,
 }
 
-/// Runs a loaded scenario and writes every output into `out`.
+/// Where and how [`run_scenario`] writes.
+pub struct OutputFolder<'a> {
+    /// The folder.
+    pub dir: &'a Path,
+    /// Replace the files of an earlier run (`--force`).
+    pub force: bool,
+}
+
+/// Runs a loaded scenario and writes every output into `out.dir`, which it holds locked
+/// against other runs until the last file is written.
 pub fn run_scenario(
     scenario: ExperimentScenario,
-    out: &Path,
+    out: OutputFolder,
     runs: Option<usize>,
     json: bool,
 ) -> Result<()> {
     let t_all = Instant::now();
+    let _lock = driftless::io::output::claim_folder(out.dir, out.force)?;
+    driftless::io::output::remove_stale_partials(out.dir.join(FIGURES));
+    let out = out.dir;
     let show = !json;
     let sp = crate::demo_cmd::spinner(
         show,
@@ -60,7 +77,6 @@ pub fn run_scenario(
             k
         );
     }
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
 
     let noise_bar = crate::demo_cmd::spinner(
         show,
@@ -111,7 +127,11 @@ pub fn run_scenario(
 
 pub fn run(a: ExperimentArgs) -> Result<()> {
     let sc = ExperimentScenario::from_file(&a.scenario)?;
-    run_scenario(sc, &a.out, a.runs, a.json)
+    let out = OutputFolder {
+        dir: &a.out,
+        force: a.force,
+    };
+    run_scenario(sc, out, a.runs, a.json)
 }
 
 fn print_human(p: &Prepared, r: &ExperimentResult) {
@@ -198,7 +218,7 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
         .with_context(|| format!("writing {}", path.display()))?;
     written.push(path);
     let figs = driftless::experiment::report::figures(p, r);
-    let fig_dir = out.join("figures");
+    let fig_dir = out.join(FIGURES);
     std::fs::create_dir_all(&fig_dir).with_context(|| format!("creating {}", fig_dir.display()))?;
     for (name, _, fig) in &figs {
         let path = fig_dir.join(format!("{name}.svg"));
@@ -206,6 +226,7 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
             .with_context(|| format!("writing {}", path.display()))?;
         written.push(path);
     }
+    remove_earlier_figures(&fig_dir, &written)?;
     let html = driftless::experiment::report::html_report(p, r, &figs)?;
     let path = out.join("report.html");
     driftless::report::html::write_html(&path, &html)
@@ -219,4 +240,25 @@ pub fn write_outputs(out: &Path, p: &Prepared, r: &ExperimentResult) -> Result<V
     .with_context(|| format!("writing {}", path.display()))?;
     written.push(path);
     Ok(written)
+}
+
+/// The figures' folder inside the output folder.
+const FIGURES: &str = "figures";
+
+/// Removes the figures (`*.svg`) in `fig_dir` that this run did not write (`written`): a
+/// figure of an earlier experiment must not sit beside this run's.
+fn remove_earlier_figures(fig_dir: &Path, written: &[PathBuf]) -> Result<()> {
+    let entries =
+        std::fs::read_dir(fig_dir).with_context(|| format!("reading {}", fig_dir.display()))?;
+    for e in entries {
+        let p = e
+            .with_context(|| format!("reading {}", fig_dir.display()))?
+            .path();
+        let svg = p.extension().is_some_and(|x| x == "svg") && p.is_file();
+        if svg && !written.iter().any(|w| w.file_name() == p.file_name()) {
+            std::fs::remove_file(&p)
+                .with_context(|| format!("removing {} of an earlier run", p.display()))?;
+        }
+    }
+    Ok(())
 }

@@ -198,9 +198,10 @@ pub fn run(a: NavArgs) -> Result<()> {
         return Ok(());
     }
     let cfg = load_config(&a)?;
-    if let Some(dir) = &a.out {
-        driftless::io::output::refuse_folder_in_use(dir, a.force)?;
-    }
+    // Held until the last file is written.
+    let _lock = (a.out.as_ref())
+        .map(|dir| driftless::io::output::claim_folder(dir, a.force))
+        .transpose()?;
     let imu_file = (cfg.config.imu.file.as_deref()).map(|p| cfg.path("imu.file", p));
     let gnss_file = (cfg.config.gnss.file.as_deref()).map(|p| cfg.path("gnss.file", p));
     crate::paths::refuse_outputs_over_inputs(

@@ -102,7 +102,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         );
     }
     let dir = a.out.clone().unwrap_or_else(|| sc.output.dir.clone());
-    driftless::io::output::refuse_folder_in_use(&dir, a.force)?;
+    let _lock = driftless::io::output::claim_folder(&dir, a.force)?;
     let pb = crate::demo_cmd::spinner(!a.json, format!("simulating {}", a.scenario.display()));
     let t = Instant::now();
     let sim = sc.run()?;

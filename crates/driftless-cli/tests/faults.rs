@@ -12,10 +12,7 @@ mod common;
 use common::bin;
 
 fn scratch(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("driftless-faults-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch(&format!("faults-{tag}"))
 }
 
 fn scenario() -> PathBuf {
@@ -328,13 +325,7 @@ fn a_kill_mid_kf_gins_run_leaves_old_complete_or_no_files() {
         names.map(|n| std::fs::read(out.join(n)).unwrap())
     };
     // The earlier run: the first 60 s only.
-    let start: f64 = cfg
-        .lines()
-        .find_map(|l| l.strip_prefix("starttime:"))
-        .and_then(|v| v.split('#').next())
-        .and_then(|v| v.trim().parse().ok())
-        .unwrap();
-    let short = cfg.replace("endtime: -1", &format!("endtime: {}", start + 60.0));
+    let short = common::kf_gins_first_seconds(&cfg, 60.0);
     let old = run(&short);
     let new = run(&cfg);
     assert!(old[0] != new[0]);
@@ -370,6 +361,115 @@ fn a_kill_mid_kf_gins_run_leaves_old_complete_or_no_files() {
                 );
             }
         }
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Every command that writes a folder fails at once, exit 1, on a folder another run is
+/// writing (here the test holds the folder's lock), naming the folder; the folder is left
+/// as it was.
+#[test]
+fn a_folder_another_run_writes_is_refused_at_once() {
+    let d = scratch("locked");
+    let sim = d.join("sim");
+    simulate(&sim, 1);
+    let busy = d.join("busy");
+    std::fs::create_dir_all(&busy).unwrap();
+    std::fs::write(busy.join("kept.txt"), "another run's file").unwrap();
+    let lock = driftless::io::output::lock_folder(&busy).unwrap();
+    let yaml = std::fs::read_to_string(sim.join("kf-gins.yaml"))
+        .unwrap()
+        .replace(
+            "outputpath: \"kf-gins-out\"",
+            &format!("outputpath: \"{}\"", busy.display()),
+        );
+    assert!(yaml.contains(&busy.display().to_string()), "{yaml}");
+    std::fs::write(sim.join("busy.yaml"), yaml).unwrap();
+    let experiment = d.join("adi.toml");
+    let o = bin().args(["demo", "--print-scenario"]).output().unwrap();
+    std::fs::write(&experiment, &o.stdout).unwrap();
+    let commands: [&[&str]; 5] = [
+        &["simulate", "--force", "--out", "BUSY", "SCENARIO"],
+        &["nav", "--preset", "drive_0708", "--force", "--out", "BUSY"],
+        &["experiment", "--force", "--out", "BUSY", "EXPERIMENT"],
+        &["demo", "--force", "--out", "BUSY"],
+        &["nav", "--kf-gins", "busy.yaml"],
+    ];
+    for args in commands {
+        let clock = std::time::Instant::now();
+        let o = bin()
+            .current_dir(&sim)
+            .args(args.iter().map(|a| match *a {
+                "BUSY" => busy.clone().into_os_string(),
+                "SCENARIO" => scenario().into_os_string(),
+                "EXPERIMENT" => experiment.clone().into_os_string(),
+                a => a.into(),
+            }))
+            .output()
+            .unwrap();
+        let e = stderr_of(&o);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {e}");
+        assert!(
+            e.contains(&busy.display().to_string())
+                && e.contains("another driftless run is writing it"),
+            "{args:?}: {e}"
+        );
+        assert!(clock.elapsed() < Duration::from_secs(5), "{args:?}");
+        assert_eq!(others(&busy, &[]), ["kept.txt"], "{args:?}");
+    }
+    drop(lock);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `experiment --out` and `demo --out` refuse a folder that holds files unless `--force`,
+/// before any work; a killed run's temporary files alone do not count.
+#[test]
+fn experiment_and_demo_folders_with_files_need_force() {
+    let d = scratch("expfolder");
+    let out = d.join("exp");
+    std::fs::create_dir_all(&out).unwrap();
+    // A temporary file of a process that has ended: not another run's file.
+    let mut ended = Command::new("true").spawn().unwrap();
+    let pid = ended.id();
+    ended.wait().unwrap();
+    let stale = format!(".table1.csv.partial-{pid}-0");
+    std::fs::write(out.join(&stale), "half").unwrap();
+    std::fs::write(out.join("table1.csv"), "an earlier run\n").unwrap();
+    let scenario_file = d.join("adi.toml");
+    let o = bin().args(["demo", "--print-scenario"]).output().unwrap();
+    std::fs::write(&scenario_file, &o.stdout).unwrap();
+    for args in [
+        vec![
+            "experiment".into(),
+            "--out".into(),
+            out.clone().into_os_string(),
+            scenario_file.clone().into_os_string(),
+        ],
+        vec!["demo".into(), "--out".into(), out.clone().into_os_string()],
+        vec![
+            "demo".into(),
+            "--noise".into(),
+            "--out".into(),
+            out.clone().into_os_string(),
+        ],
+    ] {
+        let clock = std::time::Instant::now();
+        let o = bin().args(&args).output().unwrap();
+        let e = stderr_of(&o);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {e}");
+        assert!(
+            e.contains("already holds files (table1.csv)") && e.contains("--force"),
+            "{args:?}: {e}"
+        );
+        assert!(clock.elapsed() < Duration::from_secs(5), "{args:?}");
+        assert_eq!(
+            std::fs::read_to_string(out.join("table1.csv")).unwrap(),
+            "an earlier run\n"
+        );
+        // The lock taken before the refusal cleared the ended run's temporary file
+        // (where process ids can be checked).
+        #[cfg(target_os = "linux")]
+        assert!(!out.join(&stale).exists(), "{args:?}");
     }
     let _ = std::fs::remove_dir_all(&d);
 }

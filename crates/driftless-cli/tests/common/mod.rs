@@ -33,3 +33,24 @@ pub fn simulate(dir: &std::path::Path, name: &str, scenario: &str) -> std::path:
     );
     out
 }
+
+/// A new, empty folder `driftless-TAG-PID` in the temporary folder.
+pub fn scratch(tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("driftless-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A KF-GINS configuration `cfg` (as `simulate` writes it, `endtime: -1`) cut to its first
+/// `seconds` from `starttime`.
+pub fn kf_gins_first_seconds(cfg: &str, seconds: f64) -> String {
+    let start: f64 = cfg
+        .lines()
+        .find_map(|l| l.strip_prefix("starttime:"))
+        .and_then(|v| v.split('#').next())
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap();
+    assert!(cfg.contains("endtime: -1"), "{cfg}");
+    cfg.replace("endtime: -1", &format!("endtime: {}", start + seconds))
+}

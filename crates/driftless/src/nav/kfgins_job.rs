@@ -194,14 +194,9 @@ pub enum KfGinsJobError {
         /// What disagrees and what to check.
         message: String,
     },
-    /// Creating the output folder.
-    #[error("creating {path}: {error}")]
-    CreateDir {
-        /// Folder.
-        path: String,
-        /// Cause.
-        error: std::io::Error,
-    },
+    /// The output folder: it cannot be created, or another run is writing it.
+    #[error(transparent)]
+    OutputFolder(#[from] crate::io::output::OutputError),
     /// The output writer thread stopped abnormally.
     #[error("the output writer thread panicked")]
     WriterPanicked,
@@ -359,13 +354,16 @@ fn kfgins_row(n: &NavState, sensors: &SensorErrors, sd: &[f64; N_STATES]) -> KfG
 /// Run the KF-GINS configuration at `config_path` with `opts` (module docs): read it and
 /// its IMU and GNSS files (paths as written, i.e. relative to the working directory, as
 /// KF-GINS), run the forward filter while writing KF-GINS's three output files into its
-/// `outputpath` (created if missing), and with [`KfGinsJobOptions::smooth`] the smoother
+/// `outputpath` (created if missing, and locked against other runs while this one
+/// writes: [`crate::io::output::lock_folder`]), and with [`KfGinsJobOptions::smooth`] the smoother
 /// and its three files.
 pub fn run_kf_gins_job(
     config_path: &Path,
     opts: &KfGinsJobOptions,
 ) -> Result<KfGinsJob, KfGinsJobError> {
     let k = KfGinsConfig::from_file(config_path)?;
+    // Held until the last file is committed: a second run into the folder fails at once.
+    let _lock = crate::io::output::lock_folder(&k.output_dir)?;
     let cfg_name = config_path.display().to_string();
     let mut notes: Vec<String> = k
         .unknown_keys
@@ -453,10 +451,6 @@ pub fn run_kf_gins_job(
     check_initial_position(&k, &gnss, t_init, &cfg_name)?;
     let init = initial_state(&k, t_init);
 
-    std::fs::create_dir_all(&k.output_dir).map_err(|error| KfGinsJobError::CreateDir {
-        path: k.output_dir.display().to_string(),
-        error,
-    })?;
     let keep = opts.smooth || opts.keep_records;
     let run_opts = RunOptions {
         keep_epochs: keep,

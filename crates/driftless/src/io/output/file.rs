@@ -21,6 +21,33 @@ pub struct AtomicFile {
 /// Distinguishes temporary files of one process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
+/// What separates the destination's name from the writer's process id in a temporary
+/// file's name.
+const PARTIAL: &str = ".partial-";
+
+/// The temporary file for destination `name`, written by process `pid`: `.NAME.partial-PID-N`.
+fn partial_name(name: &str, pid: u32, n: u64) -> String {
+    format!(".{name}{PARTIAL}{pid}-{n}")
+}
+
+/// The destination's name and the writer's process id of the temporary file called
+/// `name` (`.NAME.partial-PID-N`, as [`AtomicFile`] names them); `None` for any other name.
+pub(super) fn parse_partial(name: &str) -> Option<(&str, u32)> {
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    let (stem, tail) = name.strip_prefix('.')?.rsplit_once(PARTIAL)?;
+    let (pid, n) = tail.split_once('-')?;
+    if stem.is_empty() || !digits(pid) || !digits(n) {
+        return None;
+    }
+    Some((stem, pid.parse().ok()?))
+}
+
+/// The id of the process that wrote the temporary file called `name`
+/// (`.NAME.partial-PID-N`, as [`AtomicFile`] names them); `None` for any other name.
+pub fn partial_owner(name: &str) -> Option<u32> {
+    parse_partial(name).map(|(_, pid)| pid)
+}
+
 impl AtomicFile {
     /// Starts writing `path`. Errors are those of creating the temporary file (a missing
     /// folder, no permission) — reported before any data is produced.
@@ -53,9 +80,11 @@ impl AtomicFile {
             })?
             .to_string_lossy()
             .into_owned();
+        // What a killed writer of this same file left: removed once it is known dead.
+        super::folder::remove_stale_partials_of(&dir, Some(&name));
         let (file, temp) = loop {
             let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-            let temp = dir.join(format!(".{name}.partial-{}-{n}", std::process::id()));
+            let temp = dir.join(partial_name(&name, std::process::id(), n));
             match OpenOptions::new().write(true).create_new(true).open(&temp) {
                 Ok(f) => break (f, temp),
                 Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
@@ -240,6 +269,31 @@ mod tests {
         write("/dev/null", "discarded").unwrap();
         let e = write("/dev/full", "no room").unwrap_err();
         assert_eq!(e.kind(), io::ErrorKind::StorageFull);
+    }
+
+    #[test]
+    fn temporary_names_carry_their_writer() {
+        let d = scratch("names");
+        let f = AtomicFile::create(d.join("imu.partial-3.csv")).unwrap();
+        let names = entries(&d);
+        assert_eq!(names.len(), 1);
+        assert_eq!(partial_owner(&names[0]), Some(std::process::id()));
+        drop(f);
+        assert_eq!(partial_owner(".imu.csv.partial-123-4"), Some(123));
+        assert_eq!(partial_owner(".a.partial-1-2.partial-77-0"), Some(77));
+        for other in [
+            "imu.csv.partial-123-4",
+            "..partial-123-4",
+            ".imu.csv.partial-123",
+            ".imu.csv.partial-123-",
+            ".imu.csv.partial--4",
+            ".imu.csv.partial-12a-4",
+            ".imu.csv.partial-99999999999-4",
+            ".imu.csv",
+        ] {
+            assert_eq!(partial_owner(other), None, "{other}");
+        }
+        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]

@@ -22,6 +22,19 @@ pub enum OutputError {
         example: String,
         more: String,
     },
+    /// Another run holds the output folder's lock ([`super::lock_folder`]).
+    #[error(
+        "output folder {path}: another driftless run is writing it (it holds the folder's \
+         lock); wait for that run to end, or choose another folder"
+    )]
+    Locked { path: String },
+    /// The output folder could not be created.
+    #[error("creating output folder {path}: {error}")]
+    CreateFolder {
+        path: String,
+        #[source]
+        error: std::io::Error,
+    },
     /// The output folder could not be inspected.
     #[error("{path}: {error}")]
     Io {
@@ -81,7 +94,9 @@ pub fn refuse_same_file<P: AsRef<Path>>(
 }
 
 /// Refuses an output folder that exists and holds anything, unless `force`: its files would
-/// mix with this run's. A missing or empty folder is fine.
+/// mix with this run's. A missing or empty folder is fine; so is one that holds only
+/// temporary files of ended runs ([`super::is_stale_partial`]) and the
+/// [`super::folder::LOCK_FILE`].
 pub fn refuse_folder_in_use(dir: impl AsRef<Path>, force: bool) -> Result<(), OutputError> {
     let dir = dir.as_ref();
     if force {
@@ -103,7 +118,12 @@ pub fn refuse_folder_in_use(dir: impl AsRef<Path>, force: bool) -> Result<(), Ou
             path: dir.display().to_string(),
             error,
         })?;
-        names.push(e.file_name().to_string_lossy().into_owned());
+        let name = e.file_name().to_string_lossy().into_owned();
+        let is_file = e.file_type().is_ok_and(|t| t.is_file());
+        if is_file && (name == super::folder::LOCK_FILE || super::is_stale_partial(&name)) {
+            continue;
+        }
+        names.push(name);
     }
     names.sort();
     match names.split_first() {
