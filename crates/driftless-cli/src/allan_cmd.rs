@@ -16,7 +16,9 @@ use driftless::io::{ImuLog, Quantity};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
+mod export;
 mod replicates;
+use export::Exports;
 use replicates::run_replicates;
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -43,7 +45,7 @@ pub struct AllanArgs {
     /// The log(s): delimited text (CSV, whitespace, single column) or binary DRIFTLOG
     /// files. Several files are replicate runs of one sensor: each is analysed, the runs'
     /// noise terms are compared and a joint model is fitted to them all.
-    #[arg(required = true, num_args = 1.., value_name = "FILE")]
+    #[arg(required_unless_present = "model", num_args = 1.., value_name = "FILE")]
     pub files: Vec<PathBuf>,
     /// Whether the values are rates (freq) or integrated (phase).
     #[arg(long, value_enum, default_value = "freq")]
@@ -102,6 +104,23 @@ pub struct AllanArgs {
     /// Save the fitted noise model (TOML) for the filter and the simulator.
     #[arg(long, value_name = "FILE")]
     pub save_model: Option<PathBuf>,
+    /// Write the noise model in other estimators' units: comma-separated FORMAT=PATH
+    /// pairs, FORMAT one of kalibr (imu.yaml), openvins (kalibr_imu_chain.yaml), vins
+    /// (acc_n, gyr_n, acc_w, gyr_w), kfgins (imunoise block), px4 (EKF2 .params),
+    /// ardupilot (EKF3 .param). Mappings: docs/noise-exports.md.
+    #[arg(long, value_name = "FORMAT=PATH,...")]
+    pub export: Vec<String>,
+    /// Values for --export, SI, replacing the model's or filling what it lacks:
+    /// KEY=VALUE,... with keys gyroscope_noise_density, gyroscope_random_walk,
+    /// accelerometer_noise_density, accelerometer_random_walk (continuous densities as in
+    /// Kalibr), gyroscope_bias_sigma, accelerometer_bias_sigma, bias_correlation_time
+    /// (KF-GINS's Gauss-Markov bias, s).
+    #[arg(long, value_name = "KEY=VALUE,...")]
+    pub export_set: Option<String>,
+    /// Export a saved noise model (from --save-model) instead of analysing a log; needs
+    /// --export.
+    #[arg(long, value_name = "FILE", conflicts_with = "files")]
+    pub model: Option<PathBuf>,
     #[command(flatten)]
     pub input: InputArgs,
 }
@@ -426,15 +445,21 @@ pub fn analyse_log_with(
 }
 
 pub fn run(a: AllanArgs) -> Result<()> {
+    if let Some(m) = &a.model {
+        return export::run_saved_model(&a, m);
+    }
+    let exports = Exports::from_args(&a)?;
+    if a.no_fit && !exports.is_empty() {
+        bail!("--export needs the noise fit (drop --no-fit)");
+    }
     let inputs: Vec<Option<&Path>> = a.files.iter().map(|f| Some(f.as_path())).collect();
-    crate::paths::refuse_outputs_over_inputs(
-        &[a.save_model.as_deref(), a.plot.as_deref()],
-        &inputs,
-    )?;
+    let mut outputs = vec![a.save_model.as_deref(), a.plot.as_deref()];
+    outputs.extend(exports.paths().map(Some));
+    crate::paths::refuse_outputs_over_inputs(&outputs, &inputs)?;
     let file = match a.files.as_slice() {
         [] => bail!("allan needs a log file"),
         [one] => one,
-        _ => return run_replicates(&a),
+        _ => return run_replicates(&a, &exports),
     };
     let cfg = analysis_config(&a)?;
     let fit = if a.no_fit {
@@ -481,6 +506,15 @@ pub fn run(a: AllanArgs) -> Result<()> {
             .save(p)
             .with_context(|| format!("writing noise model {}", p.display()))?;
     }
+    let exported = if exports.is_empty() {
+        Vec::new()
+    } else {
+        let model = out
+            .noise
+            .as_ref()
+            .context("--export needs the noise fit (drop --no-fit)")?;
+        exports.write(model)?
+    };
     if let Some(p) = &a.plot {
         crate::demo_cmd::write_plot(p, &out, &file.display().to_string())?;
     }
@@ -493,6 +527,9 @@ pub fn run(a: AllanArgs) -> Result<()> {
         }
         if let Some(p) = &a.save_model {
             outln!("noise model written to {}", p.display());
+        }
+        for line in &exported {
+            outln!("{line}");
         }
     }
     Ok(())

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::bin;
+use common::{bin, error_of};
 use driftless::sim::noise::{StaticNoiseConfig, generate};
 use driftless_model::units::{DEG, DEG_PER_H, DEG_PER_H_PER_SQRT_H, DEG_PER_SQRT_H};
 use std::fmt::Write as _;
@@ -59,20 +59,6 @@ fn json(args: &[&std::ffi::OsStr]) -> serde_json::Value {
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).unwrap()
-}
-
-/// The error of a failing run: exactly one `error:` line, nothing on stdout, no panic.
-fn error_of(args: &[&std::ffi::OsStr]) -> String {
-    let out = bin().args(args).output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert!(!out.status.success(), "expected failure: {stderr}");
-    assert!(
-        out.stdout.is_empty(),
-        "{}",
-        String::from_utf8_lossy(&out.stdout)
-    );
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    stderr
 }
 
 #[test]

@@ -23,7 +23,7 @@ struct Run {
     out: AllanOutput,
 }
 
-pub(super) fn run_replicates(a: &AllanArgs) -> Result<()> {
+pub(super) fn run_replicates(a: &AllanArgs, exports: &super::Exports) -> Result<()> {
     if a.no_fit {
         bail!(
             "comparing {} logs needs the noise fit: drop --no-fit, or analyse the files one \
@@ -138,6 +138,11 @@ pub(super) fn run_replicates(a: &AllanArgs) -> Result<()> {
             .save(p)
             .with_context(|| format!("writing noise model {}", p.display()))?;
     }
+    let exported = if exports.is_empty() {
+        Vec::new()
+    } else {
+        exports.write(&rep.joint)?
+    };
     if let Some(p) = &a.plot {
         write_plot(p, &runs, &rep)?;
     }
@@ -162,6 +167,9 @@ pub(super) fn run_replicates(a: &AllanArgs) -> Result<()> {
         }
         if let Some(p) = &a.save_model {
             outln!("joint noise model written to {}", p.display());
+        }
+        for line in &exported {
+            outln!("{line}");
         }
     }
     Ok(())

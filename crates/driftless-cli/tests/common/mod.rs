@@ -8,6 +8,21 @@ pub fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_driftless"))
 }
 
+/// Runs `driftless ARGS`, which must fail with nothing on stdout and no panic; returns its
+/// stderr.
+pub fn error_of(args: &[&std::ffi::OsStr]) -> String {
+    let out = bin().args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!out.status.success(), "expected failure: {stderr}");
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr
+}
+
 /// Runs `cmd`, which must succeed, and parses its `--json` output.
 pub fn run_json(cmd: &mut Command) -> serde_json::Value {
     let out = cmd.output().unwrap();

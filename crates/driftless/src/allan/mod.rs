@@ -10,6 +10,7 @@ pub mod analysis;
 pub mod checks;
 pub mod ci;
 pub mod estimators;
+pub mod export;
 pub mod fit;
 pub mod gmwm;
 pub mod lines;

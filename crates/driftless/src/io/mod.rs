@@ -30,6 +30,7 @@ mod timing;
 pub mod ulog;
 pub mod units;
 pub mod write;
+pub(crate) mod yaml;
 
 #[cfg(feature = "autopilot-logs")]
 pub use autopilot::{

@@ -48,7 +48,9 @@
 
 use std::path::{Path, PathBuf};
 
-use saphyr::{LoadableYamlNode, MarkedYaml, Scalar, YamlData};
+use saphyr::{MarkedYaml, Scalar, YamlData};
+
+use crate::io::yaml::mapping_get;
 
 use crate::io::{Location, LogError};
 
@@ -279,27 +281,11 @@ fn req<'a, 'i>(
         .ok_or_else(|| cx.malformed(at.clone(), format!("missing required key `{key}`")))
 }
 
-fn mapping_get<'a, 'i>(
-    map: &'a saphyr::AnnotatedMapping<'i, MarkedYaml<'i>>,
-    key: &str,
-) -> Option<(&'a MarkedYaml<'i>, &'a MarkedYaml<'i>)> {
-    map.iter()
-        .find(|(k, _)| matches!(&k.data, YamlData::Value(Scalar::String(s)) if s.as_ref() == key))
-}
-
 /// Parses a KF-GINS configuration file.
 impl KfGinsConfig {
     /// Reads and converts a KF-GINS YAML configuration file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<KfGinsConfig, LogError> {
-        let path = path.as_ref();
-        let name = path.display().to_string();
-        let text =
-            crate::io::read_config_text(path, crate::io::MAX_CONFIG_BYTES).map_err(|error| {
-                LogError::Io {
-                    path: name.clone(),
-                    error,
-                }
-            })?;
+        let (name, text) = crate::io::yaml::read_named(path.as_ref())?;
         KfGinsConfig::from_yaml_str(&text, &name)
     }
 
@@ -377,17 +363,7 @@ impl KfGinsConfigRaw {
         name: &str,
     ) -> Result<(KfGinsConfigRaw, Vec<String>), LogError> {
         let cx = Ctx { name };
-        let docs = MarkedYaml::load_from_str(text).map_err(|e| {
-            cx.malformed(
-                Location::field(name, e.marker().line(), e.marker().col() + 1),
-                e.info().to_owned(),
-            )
-        })?;
-        let Some(root) = docs.first() else {
-            return Err(LogError::Empty {
-                at: Location::input(name),
-            });
-        };
+        let root = &crate::io::yaml::load_root(text, name, "KF-GINS YAML config")?;
         let YamlData::Mapping(map) = &root.data else {
             return Err(cx.malformed(
                 cx.at(root),
@@ -695,13 +671,7 @@ impl KfGinsConfigRaw {
 /// A finite number from a scalar node (integers, floats, and quoted numbers as yaml-cpp
 /// accepts them).
 fn number(cx: &Ctx<'_>, v: &MarkedYaml<'_>, key: &str) -> Result<(f64, Location), LogError> {
-    let x = match &v.data {
-        YamlData::Value(Scalar::Integer(i)) => Some(*i as f64),
-        YamlData::Value(Scalar::FloatingPoint(f)) => Some(f.0),
-        YamlData::Value(Scalar::String(s)) => s.trim().parse::<f64>().ok(),
-        _ => None,
-    };
-    match x {
+    match crate::io::yaml::scalar_number(v) {
         Some(x) if x.is_finite() => Ok((x, cx.at(v))),
         _ => Err(cx.invalid(
             cx.at(v),
