@@ -52,7 +52,7 @@ pub struct AllanArgs {
     pub data_type: DataTypeArg,
     /// Multiply every data value by K first (after unit conversion), e.g. 1e-7 to turn a
     /// 10 MHz counter reading into fractional frequency.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", allow_hyphen_values = true, value_parser = crate::numbers::finite_nonzero)]
     pub scale: Option<f64>,
     /// Tau grid: octave, decade, all, log:N, or a comma-separated list of taus in seconds.
     #[arg(long, default_value = "log:100", value_name = "SPEC")]
@@ -65,7 +65,7 @@ pub struct AllanArgs {
     #[arg(long, value_name = "A", allow_hyphen_values = true)]
     pub alpha: Option<i32>,
     /// Confidence level of the intervals.
-    #[arg(long, default_value_t = 0.683, value_name = "CL")]
+    #[arg(long, default_value_t = 0.683, value_name = "CL", allow_hyphen_values = true, value_parser = crate::numbers::probability)]
     pub confidence: f64,
     /// Reduced-overlap OADEV (differences every m/8 samples): ~3-4x faster on long logs,
     /// slightly wider intervals (the EDF accounts for it). Only with --estimator oadev.

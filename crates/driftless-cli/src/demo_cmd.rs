@@ -32,7 +32,7 @@ pub struct DemoArgs {
     #[arg(long)]
     pub force: bool,
     /// Monte Carlo runs of the experiment (default: the built-in scenario's 20).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::numbers::count)]
     pub runs: Option<usize>,
     /// Instead of the experiment: the noise-analysis demo (18-h static log → Allan).
     #[arg(long)]
@@ -41,10 +41,10 @@ pub struct DemoArgs {
     #[arg(long)]
     pub print_scenario: bool,
     /// (--noise) Length of the simulated static log, hours.
-    #[arg(long, default_value_t = 18.0)]
+    #[arg(long, default_value_t = 18.0, allow_hyphen_values = true, value_parser = crate::numbers::positive)]
     pub hours: f64,
     /// (--noise) Sample rate, Hz.
-    #[arg(long, default_value_t = 100.0)]
+    #[arg(long, default_value_t = 100.0, allow_hyphen_values = true, value_parser = crate::numbers::positive)]
     pub rate: f64,
     /// (--noise) Random seed (the run is reproducible from it).
     #[arg(long, default_value_t = 2026)]

@@ -30,7 +30,7 @@ pub struct ExperimentArgs {
     #[arg(long)]
     pub force: bool,
     /// Monte Carlo runs (default: the scenario's `[monte_carlo] runs`).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::numbers::count)]
     pub runs: Option<usize>,
     /// Print the JSON document instead of tables.
     #[arg(long)]

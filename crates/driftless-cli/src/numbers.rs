@@ -27,6 +27,20 @@ pub fn positive(s: &str) -> Result<f64, String> {
     number(s, |v| v > 0.0, "a positive number")
 }
 
+/// A finite number other than 0 (a scale factor may be negative).
+pub fn finite_nonzero(s: &str) -> Result<f64, String> {
+    number(s, |v| v != 0.0, "a finite number other than 0")
+}
+
+/// A probability strictly between 0 and 1 (confidence levels).
+pub fn probability(s: &str) -> Result<f64, String> {
+    number(
+        s,
+        |v| v > 0.0 && v < 1.0,
+        "a number between 0 and 1 (exclusive)",
+    )
+}
+
 /// A finite number ≥ 0 (thresholds where 0 turns the check off).
 pub fn non_negative(s: &str) -> Result<f64, String> {
     number(s, |v| v >= 0.0, "zero or a positive number")

@@ -169,6 +169,36 @@ fn negative_numbers_are_values_with_a_clear_message() {
         ),
         (vec!["bench", "--hours", "-1"], "--hours", "positive"),
         (
+            vec!["allan", &file, "--rate", "100", "--confidence", "-0.5"],
+            "--confidence",
+            "between 0 and 1",
+        ),
+        (
+            vec!["allan", &file, "--rate", "100", "--scale", "0"],
+            "--scale",
+            "other than 0",
+        ),
+        (
+            vec!["demo", "--noise", "--hours", "-1"],
+            "--hours",
+            "positive",
+        ),
+        (
+            vec!["demo", "--noise", "--rate", "-50"],
+            "--rate",
+            "positive",
+        ),
+        (
+            vec!["demo", "--runs", "-2"],
+            "--runs",
+            "positive whole number",
+        ),
+        (
+            vec!["experiment", "x.toml", "--runs", "0"],
+            "--runs",
+            "positive whole number",
+        ),
+        (
             vec!["bench", "--runs", "-3"],
             "--runs",
             "positive whole number",
