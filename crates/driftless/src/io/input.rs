@@ -300,18 +300,18 @@ pub(crate) fn human_bytes(n: u64) -> String {
 /// default of [`TextOptions::max_line_bytes`].
 pub(crate) const MAX_TEXT_LINE_BYTES: usize = 1 << 20;
 
-/// Block read at a time by [`read_text_input`]: more than one line's cap, so the first
-/// block of a file without line ends already shows it.
-const TEXT_BLOCK_BYTES: usize = 2 << 20;
+/// Block read at a time by [`read_text_input`] from a pipe or device.
+const TEXT_BLOCK_BYTES: usize = 1 << 20;
 
 /// Reads a whole text input (the KF-GINS and RTKLIB readers parse from memory) with the
 /// checks that keep a wrong input from filling the memory: binary data in the first
-/// [`SNIFF_BYTES`] is [`LogError::BinaryData`], and a line longer than
-/// [`MAX_TEXT_LINE_BYTES`] is [`LogError::LineTooLong`], found in the first block read.
-/// A regular file is then read whole (its size is known and its bytes are kept as rows);
-/// a pipe, FIFO or device is read through the same handle, block by block, every block
-/// checked the same way, so `/dev/zero` or an endless stream without line ends fails
-/// within the first MiB instead of growing without bound.
+/// [`SNIFF_BYTES`] is [`LogError::BinaryData`], and a first line longer than
+/// [`MAX_TEXT_LINE_BYTES`] is [`LogError::LineTooLong`]. A regular file is then read whole
+/// by `read_regular` (its size is known and its bytes are kept as rows; the parsers check
+/// the later lines). A pipe, FIFO or device is read through the same handle, block by
+/// block, each block checked for NUL bytes and over-long lines, so `/dev/zero` or an
+/// endless stream without line ends fails within the first MiB instead of growing
+/// without bound.
 pub(crate) fn read_text_input(
     path: &Path,
     read_regular: impl FnOnce(&Path) -> Result<Vec<u8>, LogError>,
@@ -324,8 +324,38 @@ pub(crate) fn read_text_input(
     let mut file = std::fs::File::open(path).map_err(io)?;
     let regular = file.metadata().map_err(io)?.is_file();
     let mut bytes = Vec::new();
-    let mut line_start = 0usize;
-    let mut lines = 1usize;
+    (&mut file)
+        .take(SNIFF_BYTES as u64)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if let Some(e) = binary_error(&bytes, 0, &name) {
+        return Err(e);
+    }
+    let too_long = |bytes: &[u8], line_start: usize| LogError::LineTooLong {
+        at: Location::line(
+            &name,
+            1 + bytes[..line_start].iter().filter(|&&b| b == b'\n').count(),
+        ),
+        limit: MAX_TEXT_LINE_BYTES,
+    };
+    if regular {
+        if bytes.len() == SNIFF_BYTES && !bytes.contains(&b'\n') {
+            (&mut file)
+                .take((MAX_TEXT_LINE_BYTES + 1 - SNIFF_BYTES) as u64)
+                .read_to_end(&mut bytes)
+                .map_err(io)?;
+            if bytes.len() > MAX_TEXT_LINE_BYTES && !bytes.contains(&b'\n') {
+                return Err(too_long(&bytes, 0));
+            }
+        }
+        drop(bytes);
+        return read_regular(path);
+    }
+    let mut line_start = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    if bytes.len() < SNIFF_BYTES {
+        // The first read ended short: the stream is at its end.
+        return Ok(bytes);
+    }
     loop {
         let from = bytes.len();
         let got = (&mut file)
@@ -333,12 +363,7 @@ pub(crate) fn read_text_input(
             .read_to_end(&mut bytes)
             .map_err(io)?;
         let block = &bytes[from..];
-        if from == 0
-            && let Some(e) = binary_error(&block[..block.len().min(SNIFF_BYTES)], 0, &name)
-        {
-            return Err(e);
-        }
-        if !regular && let Some(i) = block.iter().position(|&b| b == 0) {
+        if let Some(i) = block.iter().position(|&b| b == 0) {
             return Err(LogError::BinaryData {
                 path: name,
                 byte_offset: (from + i) as u64,
@@ -347,22 +372,12 @@ pub(crate) fn read_text_input(
         }
         if let Some(i) = block.iter().rposition(|&b| b == b'\n') {
             line_start = from + i + 1;
-            lines += block.iter().filter(|&&b| b == b'\n').count();
         }
         if bytes.len() - line_start > MAX_TEXT_LINE_BYTES {
-            return Err(LogError::LineTooLong {
-                at: Location::line(&name, lines),
-                limit: MAX_TEXT_LINE_BYTES,
-            });
+            return Err(too_long(&bytes, line_start));
         }
         if got < TEXT_BLOCK_BYTES {
             return Ok(bytes);
-        }
-        if regular {
-            // The checks passed on the first block: the rest is read as the caller reads
-            // regular files (in parallel blocks for the large ones).
-            drop(bytes);
-            return read_regular(path);
         }
     }
 }
