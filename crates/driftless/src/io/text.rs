@@ -1329,6 +1329,14 @@ fn read_impl<R: Read>(
                 }
                 offset += this_len;
             }
+            if !eof && !sample.is_empty() && sample.len() <= REFERENCE_SAMPLE + 2 {
+                // The plan's votes (delimiter, reference field count) take the same lines
+                // whatever the chunk size: read on until the sample is full or the input
+                // ends (at most REFERENCE_SAMPLE + 3 lines of at most `max_line_bytes`).
+                let n = buf.len();
+                buf.resize(n.saturating_mul(2), 0);
+                continue;
+            }
             if sample.is_empty() {
                 line_base += lines(region).count();
                 start = end;
@@ -1828,6 +1836,32 @@ mod tests {
             assert_eq!(p.concat(), data.to_vec());
             for piece in &p {
                 assert_eq!(piece.last(), Some(&b'\n'));
+            }
+        }
+    }
+
+    /// The plan's votes must not depend on how much of the input the first chunk holds:
+    /// inputs whose first lines disagree on the delimiter (found by fuzzing) give the same
+    /// log or error at every chunk size as in one piece.
+    #[test]
+    fn chunk_size_does_not_change_the_delimiter_vote() {
+        let inputs: [&[u8]; 3] = [
+            b"time,gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z\n0.00,nan-0.02,0.03,0.1,0.2,-9.8\n\
+              0.01,0.011,-0.021,0.031,0.11,0.21,-9.81\n0.02,0.012,-0.022,0.032,0.12,0.22,-9.79\n",
+            b"\" rate-only log\ngyro_x [deg/s];gyro_y [deg/s];gyro_z [deg/s]\n0.5;-0.25;1e-3\n\
+              0.52;-0.26;1.1e-3\n0.49;-0.24;0.9e-3\n",
+            b"t,a,b\n0,1,2\n1 2 3\n2 3 4\n3 4 5\n4 5 6\n",
+        ];
+        for (k, input) in inputs.into_iter().enumerate() {
+            let base = TextOptions::default().with_rate_hz(100.0);
+            let whole = read_text_bytes(input, "f", &base).map_err(|e| e.to_string());
+            for chunk_bytes in [1, 16, 40, 64, 65, 100] {
+                let o = TextOptions {
+                    chunk_bytes,
+                    ..base.clone()
+                };
+                let chunked = read_text(input, "f", &o).map_err(|e| e.to_string());
+                assert_eq!(chunked, whole, "input {k}, chunk {chunk_bytes}");
             }
         }
     }
