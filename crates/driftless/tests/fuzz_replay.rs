@@ -1,8 +1,9 @@
 //! The fuzz targets' invariants under stable `cargo test`: every seed of
 //! `fuzz/corpus/<target>/`, and a fixed set of deterministic mutations of the seeds (bit
-//! flips, interesting bytes, truncations, deletions, duplications, splices of two seeds),
-//! through the same harness bodies libFuzzer runs (`fuzz/src`, included here). A failure
-//! names the seed and the mutation and prints the input.
+//! flips, interesting bytes, runs of one byte, truncations, deletions, duplications,
+//! splices of two seeds, extreme numbers), through the same harness bodies libFuzzer runs
+//! (`fuzz/src`, included here). A failure names the seed and the mutation and prints the
+//! input.
 
 #[path = "../../../fuzz/src/lib.rs"]
 mod harness;
@@ -36,7 +37,7 @@ fn mutate(rng: &mut Rng, seed: &[u8], other: &[u8]) -> (Vec<u8>, String) {
         b.push(0);
     }
     let at = rng.below(b.len());
-    let what = match rng.below(7) {
+    let what = match rng.below(8) {
         0 => {
             let bit = rng.below(8);
             b[at] ^= 1 << bit;
@@ -68,6 +69,13 @@ fn mutate(rng: &mut Rng, seed: &[u8], other: &[u8]) -> (Vec<u8>, String) {
             b.truncate(at);
             b.extend_from_slice(&other[from..]);
             format!("splice at {at} with another seed from {from}")
+        }
+        6 => {
+            // A run of one byte (a stretch of binary data in a text, say).
+            let v = rng.below(256) as u8;
+            let end = (at + 1 + rng.below(64)).min(b.len());
+            b[at..end].fill(v);
+            format!("bytes {at}..{end} := 0x{v:02x}")
         }
         _ => {
             // A number replaced by an extreme one, where the seed is text.

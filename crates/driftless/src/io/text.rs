@@ -1262,11 +1262,16 @@ fn read_impl<R: Read>(
                 Err(e) => return Err(io(e)),
             }
         }
-        // The input's first SNIFF_BYTES, whatever the chunk size.
-        if let Some(left) = (SNIFF_BYTES as u64).checked_sub(consumed)
-            && let Some(e) = binary_error(&buf[..filled.min(left as usize)], consumed, source)
-        {
-            return Err(e);
+        // The input's first SNIFF_BYTES, whatever the chunk size: read them whole before
+        // judging (the share of bytes that are not UTF-8 is a share of this window), once.
+        if consumed == 0 {
+            if !eof && filled < SNIFF_BYTES {
+                buf.resize(SNIFF_BYTES, 0);
+                continue;
+            }
+            if let Some(e) = binary_error(&buf[..filled.min(SNIFF_BYTES)], 0, source) {
+                return Err(e);
+            }
         }
         let end = if eof {
             filled
@@ -1840,12 +1845,17 @@ mod tests {
         }
     }
 
-    /// The plan's votes must not depend on how much of the input the first chunk holds:
-    /// inputs whose first lines disagree on the delimiter (found by fuzzing) give the same
-    /// log or error at every chunk size as in one piece.
+    /// The outcome must not depend on how much of the input the first chunk holds:
+    /// inputs whose first lines disagree on the delimiter, and one whose first bytes are
+    /// partly not UTF-8 (found by fuzzing), give the same log or error at every chunk size
+    /// as in one piece.
     #[test]
-    fn chunk_size_does_not_change_the_delimiter_vote() {
-        let inputs: [&[u8]; 3] = [
+    fn chunk_size_does_not_change_the_outcome() {
+        let inputs: [&[u8]; 4] = [
+            b"# rate-only log\ngyro_x [deg/\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\
+              \x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\
+              \x8d\x8d\x8d\x8ds];gyro_y [deg/s];gyro_z [deg/s]\n0.5;-0.25;1e-3\n\
+              0.52;-0.26;1.1e-3\n0.49;-0.24;0.9e-3\n",
             b"time,gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z\n0.00,nan-0.02,0.03,0.1,0.2,-9.8\n\
               0.01,0.011,-0.021,0.031,0.11,0.21,-9.81\n0.02,0.012,-0.022,0.032,0.12,0.22,-9.79\n",
             b"\" rate-only log\ngyro_x [deg/s];gyro_y [deg/s];gyro_z [deg/s]\n0.5;-0.25;1e-3\n\
