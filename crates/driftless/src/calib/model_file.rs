@@ -175,11 +175,16 @@ impl CalibrationFile {
                     source,
                 }
             })?;
-        let f: CalibrationFile = toml::from_str(&text).map_err(|e| ModelFileError::Parse {
-            path: name.clone(),
+        CalibrationFile::from_toml_str(&text, &name)
+    }
+
+    /// Parses and validates a file's text; `name` (the file's path) leads every error.
+    pub fn from_toml_str(text: &str, name: &str) -> Result<CalibrationFile, ModelFileError> {
+        let f: CalibrationFile = toml::from_str(text).map_err(|e| ModelFileError::Parse {
+            path: name.to_owned(),
             message: e.to_string(),
         })?;
-        f.validate(&name)?;
+        f.validate(name)?;
         Ok(f)
     }
 

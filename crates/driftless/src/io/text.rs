@@ -1262,11 +1262,16 @@ fn read_impl<R: Read>(
                 Err(e) => return Err(io(e)),
             }
         }
-        // The input's first SNIFF_BYTES, whatever the chunk size.
-        if let Some(left) = (SNIFF_BYTES as u64).checked_sub(consumed)
-            && let Some(e) = binary_error(&buf[..filled.min(left as usize)], consumed, source)
-        {
-            return Err(e);
+        // The input's first SNIFF_BYTES, whatever the chunk size: read them whole before
+        // judging (the share of bytes that are not UTF-8 is a share of this window), once.
+        if consumed == 0 {
+            if !eof && filled < SNIFF_BYTES {
+                buf.resize(SNIFF_BYTES, 0);
+                continue;
+            }
+            if let Some(e) = binary_error(&buf[..filled.min(SNIFF_BYTES)], 0, source) {
+                return Err(e);
+            }
         }
         let end = if eof {
             filled
@@ -1328,6 +1333,14 @@ fn read_impl<R: Read>(
                     }
                 }
                 offset += this_len;
+            }
+            if !eof && !sample.is_empty() && sample.len() <= REFERENCE_SAMPLE + 2 {
+                // The plan's votes (delimiter, reference field count) take the same lines
+                // whatever the chunk size: read on until the sample is full or the input
+                // ends (at most REFERENCE_SAMPLE + 3 lines of at most `max_line_bytes`).
+                let n = buf.len();
+                buf.resize(n.saturating_mul(2), 0);
+                continue;
             }
             if sample.is_empty() {
                 line_base += lines(region).count();
@@ -1828,6 +1841,37 @@ mod tests {
             assert_eq!(p.concat(), data.to_vec());
             for piece in &p {
                 assert_eq!(piece.last(), Some(&b'\n'));
+            }
+        }
+    }
+
+    /// The outcome must not depend on how much of the input the first chunk holds:
+    /// inputs whose first lines disagree on the delimiter, and one whose first bytes are
+    /// partly not UTF-8 (found by fuzzing), give the same log or error at every chunk size
+    /// as in one piece.
+    #[test]
+    fn chunk_size_does_not_change_the_outcome() {
+        let inputs: [&[u8]; 4] = [
+            b"# rate-only log\ngyro_x [deg/\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\
+              \x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\x8d\
+              \x8d\x8d\x8d\x8ds];gyro_y [deg/s];gyro_z [deg/s]\n0.5;-0.25;1e-3\n\
+              0.52;-0.26;1.1e-3\n0.49;-0.24;0.9e-3\n",
+            b"time,gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z\n0.00,nan-0.02,0.03,0.1,0.2,-9.8\n\
+              0.01,0.011,-0.021,0.031,0.11,0.21,-9.81\n0.02,0.012,-0.022,0.032,0.12,0.22,-9.79\n",
+            b"\" rate-only log\ngyro_x [deg/s];gyro_y [deg/s];gyro_z [deg/s]\n0.5;-0.25;1e-3\n\
+              0.52;-0.26;1.1e-3\n0.49;-0.24;0.9e-3\n",
+            b"t,a,b\n0,1,2\n1 2 3\n2 3 4\n3 4 5\n4 5 6\n",
+        ];
+        for (k, input) in inputs.into_iter().enumerate() {
+            let base = TextOptions::default().with_rate_hz(100.0);
+            let whole = read_text_bytes(input, "f", &base).map_err(|e| e.to_string());
+            for chunk_bytes in [1, 16, 40, 64, 65, 100] {
+                let o = TextOptions {
+                    chunk_bytes,
+                    ..base.clone()
+                };
+                let chunked = read_text(input, "f", &o).map_err(|e| e.to_string());
+                assert_eq!(chunked, whole, "input {k}, chunk {chunk_bytes}");
             }
         }
     }

@@ -224,12 +224,20 @@ impl ThermalModelFile {
                     source,
                 }
             })?;
-        let f: ThermalModelFile =
-            toml::from_str(&text).map_err(|e| ThermalModelError::Invalid {
-                path: name.clone(),
-                message: e.to_string(),
-            })?;
-        let m = f.model(&name)?;
+        ThermalModelFile::from_toml_str(&text, &name)
+    }
+
+    /// Parses a file's text and builds its model; `name` (the file's path) leads every
+    /// error.
+    pub fn from_toml_str(
+        text: &str,
+        name: &str,
+    ) -> Result<(ThermalModelFile, CompensationModel), ThermalModelError> {
+        let f: ThermalModelFile = toml::from_str(text).map_err(|e| ThermalModelError::Invalid {
+            path: name.to_owned(),
+            message: e.to_string(),
+        })?;
+        let m = f.model(name)?;
         Ok((f, m))
     }
 
