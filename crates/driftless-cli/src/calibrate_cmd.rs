@@ -213,7 +213,11 @@ fn multi(m: MultiArgs) -> Result<()> {
             // not set aside for its row order.
             if let (Some(ta), Some(tg)) = (&acc_log.time_s, &gl.time_s) {
                 let tol = 0.5 * acc_log.tau0_s.min(gl.tau0_s);
-                if let Some(i) = ta.iter().zip(tg).position(|(a, b)| !((a - b).abs() <= tol)) {
+                if let Some(i) = ta
+                    .iter()
+                    .zip(tg)
+                    .position(|(a, b)| (a - b).abs().is_nan() || (a - b).abs() > tol)
+                {
                     bail!(
                         "{} and {} are not sampled together: sample {} is at t = {} s in the \
                          first and t = {} s in the second (more than half a sample interval \
