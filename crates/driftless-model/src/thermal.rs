@@ -61,6 +61,8 @@ impl fmt::Display for ThermalPolyError {
     }
 }
 
+impl core::error::Error for ThermalPolyError {}
+
 /// p(T) = Σ_{k=0}^{5} c_k (T − T_ref)^k, valid for T_min ≤ T ≤ T_max (°C).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ThermalPoly {

@@ -3,20 +3,19 @@
 //! Simulates a short drive (consumer-grade IMU at 100 Hz, 1 Hz GNSS with a lever arm
 //! and one 20 s outage) from an inline scenario ([`driftless::sim::scenario`]), runs the
 //! error-state Kalman filter ([`driftless::nav::session::run_session`]: static gyro
-//! priming, alignment from the GNSS course, forward pass) and the Rauch–Tung–Striebel
-//! smoother ([`driftless::nav::filter::smooth`]), and prints the horizontal RMS error of
-//! both against the simulation truth after 60 s of convergence.
+//! priming, alignment from the GNSS course, forward pass), smooths the run
+//! ([`driftless::nav::session::SessionResult::smooth`], Rauch–Tung–Striebel), and prints
+//! the horizontal RMS error of both against the simulation truth after 60 s of
+//! convergence.
+//!
+//! With your own data, build the inputs from arrays instead of a scenario:
+//! `ImuStream::from_log(&ImuLog::from_rates(name, time_s, &gyro_rad_s, &accel_m_s2)?)?`
+//! and `GnssFixes::new(time_s, lat_rad, lon_rad, height_m, sigma_ned_m)?`.
 //!
 //! Run: `cargo run --release -p driftless --example gnss_ins`
 
-use std::error::Error;
-
-use driftless::eval::metrics::horizontal_errors;
-use driftless::eval::reference::from_nav_states;
-use driftless::io::nav::NavSolution;
-use driftless::nav::filter::{FilterConfig, smooth};
-use driftless::nav::session::{SessionConfig, consumer_mems_noise, run_session};
-use driftless::sim::scenario::Scenario;
+use driftless::nav::session::consumer_mems_noise;
+use driftless::prelude::*;
 
 const SCENARIO: &str = r#"
 seed = 5
@@ -35,34 +34,20 @@ segment = [
 ]
 "#;
 
-fn main() -> Result<(), Box<dyn Error>> {
+fn main() -> driftless::Result<()> {
     let sim = Scenario::from_toml_str(SCENARIO, "inline scenario")?.run()?;
     let gnss = sim
         .gnss
         .as_ref()
-        .ok_or("the scenario has a [gnss] section")?;
-    let cfg = SessionConfig::new(FilterConfig::new(consumer_mems_noise(), sim.lever_arm_b_m));
-    let forward = run_session(&sim.imu_stream("sim"), gnss, &cfg)?;
-    let smoothed = smooth(&forward.run, &forward.init, &cfg.filter)?;
+        .expect("the scenario has a [gnss] section");
+    let filter = FilterConfig::new(consumer_mems_noise(), sim.lever_arm_b_m);
+    let forward = run_session(&sim.imu_stream("sim"), gnss, &SessionConfig::new(filter))?;
+    let smoothed = forward.smooth()?;
+    // Horizontal RMS error against the truth, from 60 s after the first fix.
+    let from_s = gnss.time_s[0] + 60.0;
+    let (rms_fwd, _) = horizontal_rms_m(&sim.truth, &forward.solution(), from_s, 1.0)?;
+    let (rms_sm, _) = horizontal_rms_m(&sim.truth, &smoothed.solution(), from_s, 1.0)?;
 
-    // Horizontal RMS error against the truth, epochs from 60 s after the first fix.
-    let t_start = gnss.time_s[0] + 60.0;
-    let rms = |sol: NavSolution| -> Result<f64, Box<dyn Error>> {
-        let errs = horizontal_errors(&sim.truth, &sol, 1.0)?;
-        let sq: Vec<f64> = sol
-            .time_s
-            .iter()
-            .zip(errs)
-            .filter(|(t, _)| **t >= t_start)
-            .filter_map(|(_, e)| e.map(|e| e * e))
-            .collect();
-        if sq.is_empty() {
-            return Err("no solution epoch overlaps the truth".into());
-        }
-        Ok((sq.iter().sum::<f64>() / sq.len().max(1) as f64).sqrt())
-    };
-    let rms_fwd = rms(from_nav_states(forward.run.epochs.iter().map(|e| &e.nav)))?;
-    let rms_sm = rms(from_nav_states(smoothed.epochs.iter().map(|e| &e.nav)))?;
     println!("horizontal RMS vs truth: forward {rms_fwd:.3} m, smoothed {rms_sm:.3} m");
     assert!(rms_fwd < 2.0, "forward RMS {rms_fwd} m");
     assert!(

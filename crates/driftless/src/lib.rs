@@ -1,11 +1,18 @@
 //! `driftless`: from raw MEMS IMU logs to a navigation error budget.
 //!
-//! Data flows one way: [`io`] readers → typed columnar logs ([`io::log`]) →
-//! algorithms ([`allan`], …) → results → writers and [`report`]s.
-//! Algorithms never parse files; readers never do math.
+//! Data flows one way: [`io`] readers → the validated in-memory types of [`data`]
+//! ([`data::ImuLog`], [`data::GnssFixes`], [`data::NavSolution`]) → algorithms
+//! ([`allan`], [`calib`], [`thermal`], [`nav`], [`eval`]) → results → writers and
+//! [`report`]s. Algorithms never touch files; readers never do math. [`sim`] makes data
+//! with known truth; [`experiment`] runs the seed paper's outage study.
+//!
+//! Start with `use driftless::prelude::*;` ([`prelude`]): the data types, the entry
+//! point of each stage, and the crate's one [`Error`] (every stage's error converts
+//! into it with `?`; its `source()` chain is the stage error's).
 //!
 //! Conventions: SI inside (s, m, rad, m/s, m/s², rad/s, °C). Display/file units
-//! (deg/h, deg/√h, mg, g …) are converted at the edges only.
+//! (deg/h, deg/√h, mg, g …) are converted at the edges only; names carry units and
+//! frames (`gyro_rad_s`, `sigma_ned_m`, `lever_arm_b_m`).
 //!
 //! Runnable programs for each stage are in `crates/driftless/examples/`
 //! (`cargo run --release -p driftless --example allan_oadev`, `six_position`,
@@ -100,44 +107,49 @@
 //!
 //! # Navigation ([`nav`])
 //!
-//! Strapdown mechanization of increments (here of an error-free IMU at rest, 10 s):
-//! the position stays put. The GNSS/INS filter and smoother are
-//! [`nav::session::run_session`] and [`nav::filter::smooth`] (example `gnss_ins`).
+//! The loosely coupled GNSS/INS filter and smoother on arrays in memory (here an
+//! error-free IMU at rest for 60 s and a fix every second at the same place): the
+//! solution stays put.
 //!
 //! ```
-//! use driftless::nav::{earth, mechanization::mechanize};
-//! use driftless::sim::scenario::Scenario;
+//! use driftless::prelude::*;
 //!
-//! let text = r#"
-//! [imu]
-//! rate_hz = 100.0
-//! preset = "ideal"
-//! [trajectory]
-//! type = "static"
-//! lat_deg = 30.0
-//! duration_s = 10.0
-//! "#;
-//! let sim = Scenario::from_toml_str(text, "inline")?.run()?;
-//! let epochs = sim.imu_stream("static").epochs;
-//! let (mut nav, mut prev) = (sim.initial, epochs[0]);
-//! for inc in &epochs {
-//!     nav = mechanize(&nav, &prev, inc);
-//!     prev = *inc;
-//! }
-//! let start = (sim.initial.lat_rad, sim.initial.lon_rad, sim.initial.height_m);
-//! let drift_m = earth::ned_offset_m(start, (nav.lat_rad, nav.lon_rad, nav.height_m));
-//! assert!(drift_m.iter().all(|d| d.abs() < 1e-3), "{drift_m:?}");
-//! # Ok::<(), driftless::sim::scenario::ScenarioError>(())
+//! let (lat_rad, lon_rad, h_m) = (30f64.to_radians(), 114f64.to_radians(), 20.0);
+//! let g = driftless::nav::earth::gravity_ned(lat_rad, h_m)[2];
+//! let w_ie = driftless::nav::earth::OMEGA_IE;
+//! let n = 6001; // 100 Hz
+//! let t: Vec<f64> = (0..n).map(|k| 1000.0 + k as f64 / 100.0).collect();
+//! // Body = NED (level, heading north): the gyros sense the Earth rate.
+//! let gyro = vec![[w_ie * lat_rad.cos(), 0.0, -w_ie * lat_rad.sin()]; n];
+//! let accel = vec![[0.0, 0.0, -g]; n];
+//! let imu = ImuStream::from_log(&ImuLog::from_rates("memory", t, &gyro, &accel)?)?;
+//! let fix_t: Vec<f64> = (1..60).map(|k| 1000.0 + k as f64).collect();
+//! let m = fix_t.len();
+//! let gnss = GnssFixes::new(fix_t, vec![lat_rad; m], vec![lon_rad; m], vec![h_m; m], vec![[0.5; 3]; m])?;
+//! let mut cfg = SessionConfig::new(FilterConfig::new(driftless::nav::session::consumer_mems_noise(), [0.0; 3]));
+//! cfg.initial_yaw_rad = Some(0.0);
+//! let forward = run_session(&imu, &gnss, &cfg)?;
+//! let s = forward.smooth()?.solution();
+//! let mid = s.time_s.len() / 2;
+//! let at = (s.lat_rad[mid], s.lon_rad[mid], s.height_m[mid]);
+//! let offset = driftless::nav::earth::ned_offset_m((lat_rad, lon_rad, h_m), at);
+//! assert!(offset.iter().all(|d| d.abs() < 0.5), "{offset:?}");
+//! # Ok::<(), driftless::Error>(())
 //! ```
 // One audited exception: the AVX2 dispatch of the Allan kernel (allan::estimators).
 #![deny(unsafe_code)]
 
 pub mod allan;
 pub mod calib;
+pub mod data;
+pub mod error;
 pub mod eval;
 pub mod experiment;
 pub mod io;
 pub mod nav;
+pub mod prelude;
 pub mod report;
 pub mod sim;
 pub mod thermal;
+
+pub use error::{Error, Result};

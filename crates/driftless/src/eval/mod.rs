@@ -20,11 +20,13 @@
 //! column of the trajectories. A window is the half-open interval (start, end]
 //! of [`OutageWindow`]: the fix at the start is used, the one at the end is withheld.
 
+pub mod accuracy;
 pub mod dynamics;
 pub mod metrics;
 pub mod reference;
 pub mod select;
 
+pub use accuracy::horizontal_rms_m;
 pub use dynamics::{ClassMix, Dynamics, DynamicsThresholds, classify};
 pub use metrics::{MetricOptions, OutageErrors, OutageReport, outage_errors};
 pub use select::{SelectOptions, SelectedOutage, check_outages, resolve_outages, select_outages};

@@ -20,7 +20,10 @@ pub mod dataflash;
 pub(crate) mod edge;
 pub mod error;
 pub mod input;
-pub mod log;
+/// The IMU log types, kept here for readers' signatures; they live in [`crate::data`].
+pub mod log {
+    pub use crate::data::imu::*;
+}
 pub mod nav;
 mod number;
 pub mod output;

@@ -1,5 +1,10 @@
-//! Navigation: Earth model, attitude conventions, strapdown mechanization and (next) the
-//! GNSS/INS error-state Kalman filter and smoother.
+//! Navigation: Earth model, attitude conventions, strapdown mechanization, the loosely
+//! coupled GNSS/INS error-state Kalman filter and the Rauch–Tung–Striebel smoother.
+//!
+//! In memory: [`session::run_session`] on an [`pipeline::ImuStream`] and
+//! [`crate::io::nav::GnssFixes`] gives the forward run; [`session::SessionResult::smooth`]
+//! smooths it; `.solution()` on either gives the trajectory. From files:
+//! [`kfgins_job`] runs a KF-GINS configuration.
 //!
 //! Frames: navigation = local NED, body = forward-right-down, Earth = WGS-84. SI inside.
 
@@ -9,6 +14,7 @@ pub mod earth;
 pub mod filter;
 pub mod gnss_floor;
 pub mod imu_check;
+pub mod in_memory;
 pub mod job;
 pub mod kfgins_job;
 pub mod mechanization;

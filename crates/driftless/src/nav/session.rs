@@ -68,7 +68,8 @@ use driftless_model::linalg::{Vec3, add, norm, scale};
 /// Settings of a session beyond the filter's own.
 #[derive(Clone, Debug)]
 pub struct SessionConfig {
-    /// The filter (noise, lever arm, gating …); its `outages_s` is overwritten from `outages`.
+    /// The filter (noise, lever arm, gating …). Leave its `outages_s` empty: the session
+    /// sets it from `outages` ([`run_session`] refuses a different list there).
     pub filter: FilterConfig,
     /// GNSS outage windows, absolute GNSS times.
     pub outages: Vec<OutageWindow>,
@@ -167,6 +168,9 @@ pub struct SessionResult {
     pub sigma_floors: Vec<super::gnss_floor::ClassFloor>,
     /// The initial state used.
     pub init: InitialState,
+    /// The filter configuration of the forward run (the session's outage windows in
+    /// `outages_s`): with `init`, what the smoother needs ([`SessionResult::smooth`]).
+    pub filter: FilterConfig,
     /// Gyro bias primed from the static start, if it was static.
     pub primed_gyro_bias_rad_s: Option<Vec3>,
     /// RMS horizontal one-step prediction error at accepted fixes outside the convergence
@@ -181,12 +185,16 @@ pub struct SessionResult {
     pub smoothed_outages: Option<Vec<OutageResult>>,
 }
 
-/// Run the forward filter on `imu` and `gnss` and evaluate it.
+/// Run the forward filter on `imu` and `gnss` and evaluate it. The fixes are checked
+/// first ([`GnssFixes::validate`]: equal column lengths, finite values, increasing time,
+/// σ > 0).
 pub fn run_session(
     imu: &ImuStream,
     gnss: &GnssFixes,
     cfg: &SessionConfig,
 ) -> Result<SessionResult, NavError> {
+    gnss.validate()
+        .map_err(|e| NavError::Config(e.to_string()))?;
     let primed = if cfg.static_prime_s > 0.0 {
         prime_gyro_bias(imu, cfg.static_prime_s)
     } else {
@@ -207,7 +215,16 @@ pub fn run_session(
         None => gnss,
     };
     let mut fcfg = cfg.filter.clone();
-    fcfg.outages_s = cfg.outages.iter().map(|w| (w.start_s, w.end_s)).collect();
+    let outages_s: Vec<(f64, f64)> = cfg.outages.iter().map(|w| (w.start_s, w.end_s)).collect();
+    if !fcfg.outages_s.is_empty() && fcfg.outages_s != outages_s {
+        return Err(NavError::Config(format!(
+            "two outage lists: the filter configuration names {} window(s) in outages_s, \
+             the session {} in outages; set the windows in SessionConfig::outages only",
+            fcfg.outages_s.len(),
+            outages_s.len()
+        )));
+    }
+    fcfg.outages_s = outages_s;
     let data_gaps = gnss_data_gaps(&used.time_s);
     // Convergence periods: after the start t0, and after each outage window and data gap.
     let excluded_from = |t0: f64, outages: &[OutageWindow]| {
@@ -316,6 +333,7 @@ pub fn run_session(
     Ok(SessionResult {
         run,
         init,
+        filter: fcfg,
         sigma_floors: floors,
         primed_gyro_bias_rad_s: primed,
         horizontal_rms_m,

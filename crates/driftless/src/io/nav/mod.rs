@@ -20,7 +20,10 @@ pub mod kfgins;
 pub mod kfgins_config;
 pub mod rtklib;
 pub mod track;
-pub mod types;
+/// The navigation record types; they live in [`crate::data::nav`].
+pub mod types {
+    pub use crate::data::nav::*;
+}
 
 pub use gpstime::{
     GpsTime, LEAP_SECONDS, ParseTimeBaseError, TimeBase, TimeBaseError, gps_minus_utc_s,
