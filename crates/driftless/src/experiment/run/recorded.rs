@@ -6,7 +6,7 @@ use crate::io::{ImuLog, Quantity};
 use crate::nav::pipeline::{ImuStream, ImuStreamOptions};
 use crate::nav::session::SessionConfig;
 
-/// Recorded vehicle data, read in [`prepare`].
+/// Recorded vehicle data, read in [`prepare`](super::prepare).
 #[derive(Debug)]
 pub struct RecordedVehicle {
     /// The IMU stream (vehicle frame).

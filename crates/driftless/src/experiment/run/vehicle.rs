@@ -40,7 +40,7 @@ pub struct CaseRun {
     pub gnss_rejected: usize,
     /// The forward solution (kept for the detailed run only).
     pub forward_solution: Option<NavSolution>,
-    /// Error budget per outage (detailed run only; [`super::budget`]).
+    /// Error budget per outage (detailed run only; [`super::budget`](crate::experiment::budget)).
     pub budgets: Option<Vec<Option<OutageBudget>>>,
 }
 

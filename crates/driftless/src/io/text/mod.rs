@@ -8,7 +8,7 @@
 //!   on or off, or names given by the caller. A header name may carry its unit in
 //!   brackets, `gyro_x [deg/s]` or `tick(ms)`; it is used when the caller gives none.
 //! * Columns: a time column (by name or 1-based index) or none; the data columns to keep
-//!   (by name or index) each with its [`Unit`]; unselected columns are only counted, never
+//!   (by name or index) each with its [`Unit`](crate::io::units::Unit); unselected columns are only counted, never
 //!   parsed. Values are converted to SI while parsing, the only math a reader does.
 //! * Week + seconds of week: with [`TextOptions::week_column`] the time column counts
 //!   seconds within a week and the week column holds the week number (whole numbers

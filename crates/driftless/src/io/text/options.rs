@@ -51,10 +51,10 @@ pub enum GapPolicy {
     /// Fail with [`LogError::TimeGap`].
     #[default]
     Error,
-    /// Keep all rows; [`ImuLog::segments`] lists the contiguous runs between gaps and
-    /// [`ImuLog::gaps`] the gaps.
+    /// Keep all rows; [`ImuLog::segments`](crate::io::ImuLog::segments) lists the contiguous runs between gaps and
+    /// [`ImuLog::gaps`](crate::io::ImuLog::gaps) the gaps.
     Split,
-    /// Keep all rows as one segment; [`ImuLog::gaps`] lists the gaps so the caller can warn.
+    /// Keep all rows as one segment; [`ImuLog::gaps`](crate::io::ImuLog::gaps) lists the gaps so the caller can warn.
     Bridge,
 }
 
@@ -82,10 +82,10 @@ pub struct TextOptions {
     /// when there is a header, and instead of `col1`, `col2`, … when there is none.
     pub column_names: Option<Vec<String>>,
     /// The time column, or `None`: then a header field named as a time column
-    /// ([`TIME_COLUMN_NAMES`], when `detect_time_column`) is taken, else the log has no
+    /// ([`TIME_COLUMN_NAMES`](super::TIME_COLUMN_NAMES), when `detect_time_column`) is taken, else the log has no
     /// time stamps and `rate_hz` is needed.
     pub time_column: Option<ColumnRef>,
-    /// Take a header field named as a time column ([`TIME_COLUMN_NAMES`]) for the time
+    /// Take a header field named as a time column ([`TIME_COLUMN_NAMES`](super::TIME_COLUMN_NAMES)) for the time
     /// when `time_column` is `None` (on by default; off reads such a field as data).
     pub detect_time_column: bool,
     /// Unit of the time column; `None` takes the header's bracketed unit, else seconds.
