@@ -143,52 +143,8 @@ pub fn analyse_segments(
     tau0_s: f64,
     cfg: &AnalysisConfig,
 ) -> Result<ChannelResult, AllanError> {
-    if !(cfg.confidence > 0.0 && cfg.confidence < 1.0) {
-        return Err(AllanError::Invalid(format!(
-            "confidence level must be between 0 and 1, got {}",
-            cfg.confidence
-        )));
-    }
-    if cfg.fast && cfg.estimator != Estimator::Oadev {
-        return Err(AllanError::Invalid(
-            "the fast estimator is a reduced-overlap OADEV; use it with --estimator oadev".into(),
-        ));
-    }
-    if let Some(a) = cfg.alpha {
-        let range = if cfg.estimator.is_hadamard() {
-            -4..=2
-        } else {
-            -2..=2
-        };
-        if !range.contains(&a) {
-            return Err(AllanError::Invalid(format!(
-                "alpha {a} is outside {}..={} for {}",
-                range.start(),
-                range.end(),
-                cfg.estimator.name()
-            )));
-        }
-    }
-    let mut offset = 0usize;
-    for seg in segments {
-        if let Some(i) = seg.iter().position(|v| !v.is_finite()) {
-            return Err(AllanError::NonFinite {
-                index: offset + i,
-                value: seg[i],
-            });
-        }
-        if let Some(i) = seg
-            .iter()
-            .position(|v| v.abs() > super::MAX_SAMPLE_MAGNITUDE)
-        {
-            return Err(AllanError::OutOfRange {
-                index: offset + i,
-                value: seg[i],
-                limit: super::MAX_SAMPLE_MAGNITUDE,
-            });
-        }
-        offset += seg.len();
-    }
+    check_config(cfg)?;
+    check_samples(segments)?;
     // Phase for each segment.
     let phases: Vec<Vec<f64>> = segments
         .par_iter()
@@ -203,20 +159,7 @@ pub fn analyse_segments(
         .ok_or_else(|| AllanError::Invalid("no data".into()))?;
     let ms = averaging_factors(&cfg.taus, tau0_s, longest.len(), cfg.estimator)?;
 
-    // Sums per segment, merged.
-    let mut total: Vec<Sums> = ms.iter().map(|&m| Sums { m, sum: 0.0, n: 0 }).collect();
-    for x in &phases {
-        let s = if cfg.fast {
-            estimators::oadev_strided_sums(x, &ms, FAST_OVERLAP)
-        } else {
-            estimators::sums(cfg.estimator, x, &ms)
-        };
-        for (t, s) in total.iter_mut().zip(s) {
-            if s.n > 0 {
-                *t = t.merge(s);
-            }
-        }
-    }
+    let total = merged_sums(&phases, &ms, cfg);
 
     let mut points = Vec::with_capacity(ms.len());
     let mut dev_lo = Vec::with_capacity(ms.len());
@@ -293,6 +236,81 @@ pub fn analyse_segments(
         fast: cfg.fast,
         rate_acf1,
     })
+}
+
+/// The configuration's confidence level, estimator and fixed noise exponent are usable.
+fn check_config(cfg: &AnalysisConfig) -> Result<(), AllanError> {
+    if !(cfg.confidence > 0.0 && cfg.confidence < 1.0) {
+        return Err(AllanError::Invalid(format!(
+            "confidence level must be between 0 and 1, got {}",
+            cfg.confidence
+        )));
+    }
+    if cfg.fast && cfg.estimator != Estimator::Oadev {
+        return Err(AllanError::Invalid(
+            "the fast estimator is a reduced-overlap OADEV; use it with --estimator oadev".into(),
+        ));
+    }
+    if let Some(a) = cfg.alpha {
+        let range = if cfg.estimator.is_hadamard() {
+            -4..=2
+        } else {
+            -2..=2
+        };
+        if !range.contains(&a) {
+            return Err(AllanError::Invalid(format!(
+                "alpha {a} is outside {}..={} for {}",
+                range.start(),
+                range.end(),
+                cfg.estimator.name()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Every sample is finite and within [`super::MAX_SAMPLE_MAGNITUDE`]; the error names the
+/// index counted over all segments.
+fn check_samples(segments: &[&[f64]]) -> Result<(), AllanError> {
+    let mut offset = 0usize;
+    for seg in segments {
+        if let Some(i) = seg.iter().position(|v| !v.is_finite()) {
+            return Err(AllanError::NonFinite {
+                index: offset + i,
+                value: seg[i],
+            });
+        }
+        if let Some(i) = seg
+            .iter()
+            .position(|v| v.abs() > super::MAX_SAMPLE_MAGNITUDE)
+        {
+            return Err(AllanError::OutOfRange {
+                index: offset + i,
+                value: seg[i],
+                limit: super::MAX_SAMPLE_MAGNITUDE,
+            });
+        }
+        offset += seg.len();
+    }
+    Ok(())
+}
+
+/// The estimator's sums at every averaging factor, per segment and merged.
+fn merged_sums(phases: &[Vec<f64>], ms: &[usize], cfg: &AnalysisConfig) -> Vec<Sums> {
+    let mut total: Vec<Sums> = ms.iter().map(|&m| Sums { m, sum: 0.0, n: 0 }).collect();
+    for x in phases {
+        let s = if cfg.fast {
+            estimators::oadev_strided_sums(x, ms, FAST_OVERLAP)
+        } else {
+            estimators::sums(cfg.estimator, x, ms)
+        };
+        for (t, s) in total.iter_mut().zip(s) {
+            if s.n > 0 {
+                *t = t.merge(s);
+            }
+        }
+    }
+    total
 }
 
 /// Analyse one contiguous channel.

@@ -59,589 +59,35 @@
 
 use std::f64::consts::{LN_2, PI};
 
-use serde::{Deserialize, Serialize};
-
 use super::AllanError;
+
+mod config;
+mod range;
+mod result;
+mod slopes;
+mod solve;
+
+use config::GM_LN_T_TOL;
+pub use config::{
+    FitConfig, FitOptions, GM_MAX_RECORD_FRACTION, GM_MIN_SAMPLES, MODEL_ERROR_FLOOR,
+};
+pub use range::{
+    ACF_COLOURED, AUTO_RANGE_MAX_M, FitRange, FitRangeSpec, RangeSource, auto_range_candidates,
+    short_tau_coloured,
+};
+pub use result::{
+    CHI2_RED_GOOD, CHI2_RED_WARN, GaussMarkovTerm, NoiseFit, NotIdentifiable, Term, TermKind,
+    UpperLimit, chi2_verdict,
+};
+use slopes::slope_alpha;
+pub use slopes::{SlopeReadings, slope_readings};
+pub(crate) use solve::golden_max;
+use solve::{IrlsSolution, covariance, golden_max_tol, irls, upper_limit};
 
 /// (2 ln2/π): Allan variance of bias instability per B².
 pub const BIAS_AVAR_COEF: f64 = 2.0 * LN_2 / PI;
 /// √(2 ln2/π) ≈ 0.6643: the Allan-deviation floor per unit bias instability.
 pub const BIAS_ADEV_FLOOR: f64 = 0.664_282_470_267_960_1;
-
-/// Which terms to fit.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct FitConfig {
-    /// Quantization noise Q.
-    pub quantization: bool,
-    /// White noise N (ARW / VRW).
-    pub white: bool,
-    /// Bias instability B (flicker floor).
-    pub bias_instability: bool,
-    /// Rate random walk K.
-    pub rate_random_walk: bool,
-    /// Rate ramp R.
-    pub rate_ramp: bool,
-    /// One first-order Gauss-Markov term (σ, correlation time).
-    pub gauss_markov: bool,
-}
-
-impl FitConfig {
-    /// Every term switched off (a starting point for building a selection).
-    pub const NONE: FitConfig = FitConfig {
-        quantization: false,
-        white: false,
-        bias_instability: false,
-        rate_random_walk: false,
-        rate_ramp: false,
-        gauss_markov: false,
-    };
-}
-
-/// Parses a comma-separated term list: `q` quantization, `n` white noise, `b` bias
-/// instability, `k` rate random walk, `r` rate ramp, `gm` one Gauss-Markov term.
-impl std::str::FromStr for FitConfig {
-    type Err = AllanError;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let mut c = FitConfig::NONE;
-        for t in s.split(',').map(|t| t.trim().to_ascii_lowercase()) {
-            match t.as_str() {
-                "q" => c.quantization = true,
-                "n" => c.white = true,
-                "b" => c.bias_instability = true,
-                "k" => c.rate_random_walk = true,
-                "r" => c.rate_ramp = true,
-                "gm" => c.gauss_markov = true,
-                "" => {}
-                other => {
-                    return Err(AllanError::Invalid(format!(
-                        "unknown noise term {other:?} in {s:?} (expected q, n, b, k, r, gm)"
-                    )));
-                }
-            }
-        }
-        Ok(c)
-    }
-}
-
-impl FitConfig {
-    /// The same selection with `kind` switched off.
-    pub fn without(self, kind: TermKind) -> FitConfig {
-        let mut c = self;
-        match kind {
-            TermKind::Quantization => c.quantization = false,
-            TermKind::White => c.white = false,
-            TermKind::BiasInstability => c.bias_instability = false,
-            TermKind::RateRandomWalk => c.rate_random_walk = false,
-            TermKind::RateRamp => c.rate_ramp = false,
-            TermKind::GaussMarkov => c.gauss_markov = false,
-        }
-        c
-    }
-
-    /// The five terms of IEEE Std 952-1997: quantization, white noise, bias
-    /// instability, rate random walk, rate ramp.
-    pub const IEEE_952: FitConfig = FitConfig {
-        quantization: true,
-        white: true,
-        bias_instability: true,
-        rate_random_walk: true,
-        rate_ramp: true,
-        gauss_markov: false,
-    };
-}
-
-/// The IEEE 952 terms and one Gauss-Markov term. Real MEMS gyros and accelerometers
-/// often carry a correlated bias whose Allan curve rises and falls again between the
-/// flicker floor and the longest τ (the sums of Gauss-Markov processes their makers and
-/// the GMWM literature model them with); the five IEEE terms can only follow it by
-/// bending a rate random walk through it. The term stays only where the data resolve
-/// it (see `noise_model::fit_supported_terms`).
-impl Default for FitConfig {
-    fn default() -> Self {
-        FitConfig {
-            gauss_markov: true,
-            ..FitConfig::IEEE_952
-        }
-    }
-}
-
-impl FitConfig {
-    /// The linear terms switched on, in model order.
-    pub fn linear_terms(&self) -> Vec<TermKind> {
-        let mut v = Vec::new();
-        for (on, k) in [
-            (self.quantization, TermKind::Quantization),
-            (self.white, TermKind::White),
-            (self.bias_instability, TermKind::BiasInstability),
-            (self.rate_random_walk, TermKind::RateRandomWalk),
-            (self.rate_ramp, TermKind::RateRamp),
-        ] {
-            if on {
-                v.push(k);
-            }
-        }
-        v
-    }
-}
-
-/// The noise terms of the model.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum TermKind {
-    /// Quantization Q.
-    Quantization,
-    /// White noise N.
-    White,
-    /// Bias instability B.
-    BiasInstability,
-    /// Rate random walk K.
-    RateRandomWalk,
-    /// Rate ramp R.
-    RateRamp,
-    /// Gauss-Markov σ.
-    GaussMarkov,
-}
-
-impl TermKind {
-    /// The linear terms of IEEE Std 952, in model order.
-    pub const LINEAR: [TermKind; 5] = [
-        TermKind::Quantization,
-        TermKind::White,
-        TermKind::BiasInstability,
-        TermKind::RateRandomWalk,
-        TermKind::RateRamp,
-    ];
-
-    /// Allan variance per unit squared coefficient at `tau` (linear terms; the
-    /// Gauss-Markov shape depends on T, see [`gauss_markov_avar`]).
-    pub fn basis(self, tau: f64) -> f64 {
-        match self {
-            TermKind::Quantization => 3.0 / (tau * tau),
-            TermKind::White => 1.0 / tau,
-            TermKind::BiasInstability => BIAS_AVAR_COEF,
-            TermKind::RateRandomWalk => tau / 3.0,
-            TermKind::RateRamp => tau * tau / 2.0,
-            TermKind::GaussMarkov => f64::NAN,
-        }
-    }
-
-    /// Power-law exponent α of the frequency PSD (S_y ∝ f^α) the term corresponds to,
-    /// clamped to the Allan-variance range −2..=2 (rate ramp is treated as random walk).
-    pub fn alpha(self) -> i32 {
-        match self {
-            TermKind::Quantization => 2,
-            TermKind::White => 0,
-            TermKind::BiasInstability => -1,
-            TermKind::RateRandomWalk | TermKind::RateRamp => -2,
-            TermKind::GaussMarkov => -1,
-        }
-    }
-
-    /// Short name.
-    pub fn name(self) -> &'static str {
-        match self {
-            TermKind::Quantization => "quantization",
-            TermKind::White => "white",
-            TermKind::BiasInstability => "bias_instability",
-            TermKind::RateRandomWalk => "rate_random_walk",
-            TermKind::RateRamp => "rate_ramp",
-            TermKind::GaussMarkov => "gauss_markov",
-        }
-    }
-}
-
-/// A fitted coefficient with its confidence interval (same confidence level as the fit).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Term {
-    /// Estimate, SI units.
-    pub value: f64,
-    /// Lower confidence bound.
-    pub lo: f64,
-    /// Upper confidence bound.
-    pub hi: f64,
-}
-
-impl Term {
-    /// Whether `x` lies inside [lo, hi].
-    pub fn covers(&self, x: f64) -> bool {
-        self.lo <= x && x <= self.hi
-    }
-}
-
-/// First-order Gauss-Markov term: b' = −b/T + w, stationary σ.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct GaussMarkovTerm {
-    /// Stationary standard deviation, data units.
-    pub sigma: Term,
-    /// Correlation time T, s.
-    pub tau_c_s: Term,
-}
-
-/// A term that was switched on but fitted to zero: not detected, with an upper limit
-/// (upper end of the two-sided interval at the fit's confidence), SI units.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct UpperLimit {
-    /// Which term.
-    pub term: TermKind,
-    /// Upper limit of the coefficient (Q, N, B, K, R or σ_GM), SI units.
-    pub upper: f64,
-}
-
-/// Result of the noise-term fit. A `None` term was switched off (or fitted to zero and dropped).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct NoiseFit {
-    /// Quantization Q, u·s.
-    pub quantization: Option<Term>,
-    /// White noise density N, u·√s (ARW rad/√s, VRW m/s/√s).
-    pub white: Option<Term>,
-    /// Bias instability B, u.
-    pub bias_instability: Option<Term>,
-    /// Rate random walk K, u/√s.
-    pub rate_random_walk: Option<Term>,
-    /// Rate ramp R, u/s.
-    pub rate_ramp: Option<Term>,
-    /// Optional Gauss-Markov term.
-    pub gauss_markov: Option<GaussMarkovTerm>,
-    /// Confidence level of the term intervals.
-    pub confidence: f64,
-    /// RMS of log10(model/measured) over the fitted points.
-    pub rms_log10_residual: f64,
-    /// Terms that were fitted but came out zero, with upper limits.
-    #[serde(default)]
-    pub not_detected: Vec<UpperLimit>,
-    /// Weighted χ² per degree of freedom of the final fit (≈ ≤ 1 for an adequate model;
-    /// the points are correlated, so this is a misfit indicator, not a test statistic).
-    #[serde(default)]
-    pub chi2_reduced: f64,
-    /// Number of (tau, avar) points fitted.
-    #[serde(default)]
-    pub n_points: usize,
-    /// The τ range the model was fitted over and how it was chosen (absent in files
-    /// written before the range was recorded).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub fit_range: Option<FitRange>,
-    /// Terms the data cannot pin down (a Gauss-Markov correlation time at its search
-    /// bound, a quantization far above the resolution step, …): reported here, never
-    /// stored as values.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub not_identifiable: Vec<NotIdentifiable>,
-}
-
-/// How the τ range of the fit was chosen.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RangeSource {
-    /// The whole curve.
-    Full,
-    /// Short τ left out automatically where the averaged rates are correlated
-    /// ([`auto_fit_start`]).
-    Auto,
-    /// Given by the user (`--fit-range`).
-    User,
-}
-
-/// The τ range of a fit.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct FitRange {
-    /// Smallest fitted τ, s.
-    pub tau_min_s: f64,
-    /// Largest fitted τ, s.
-    pub tau_max_s: f64,
-    /// How the range was chosen.
-    pub source: RangeSource,
-    /// Curve points below the range (left out).
-    pub excluded_short: usize,
-    /// Curve points above the range (left out).
-    pub excluded_long: usize,
-}
-
-/// A term that was switched on but that the data cannot determine, with the reason.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct NotIdentifiable {
-    /// Which term.
-    pub term: TermKind,
-    /// Why, in plain words.
-    pub reason: String,
-}
-
-/// χ²_red above which a fit is reported as not describing the curve.
-pub const CHI2_RED_WARN: f64 = 5.0;
-/// χ²_red up to which a fit is reported as following the curve within its uncertainty.
-pub const CHI2_RED_GOOD: f64 = 2.0;
-
-/// Plain-words reading of χ²_red and whether it deserves a warning.
-pub fn chi2_verdict(chi2_red: f64) -> (&'static str, bool) {
-    if !chi2_red.is_finite() {
-        ("no goodness of fit (too few points)", true)
-    } else if chi2_red <= CHI2_RED_GOOD {
-        (
-            "good: the model follows the curve within its uncertainty",
-            false,
-        )
-    } else if chi2_red <= CHI2_RED_WARN {
-        ("fair: small systematic departures from the curve", false)
-    } else {
-        (
-            "poor: the model does not describe the curve (check the fit range and the terms)",
-            true,
-        )
-    }
-}
-
-/// A user-given fit range `TMIN:TMAX` in seconds; an empty side means the curve's end.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FitRangeSpec {
-    /// Smallest τ to fit, s (None: from the start of the curve).
-    pub tau_min_s: Option<f64>,
-    /// Largest τ to fit, s (None: to the end of the curve).
-    pub tau_max_s: Option<f64>,
-}
-
-impl std::str::FromStr for FitRangeSpec {
-    type Err = AllanError;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let bad = |why: &str| {
-            AllanError::Invalid(format!(
-                "fit range {s:?}: {why} (expected TMIN:TMAX in seconds, e.g. 0.2:2000 or 0.2:)"
-            ))
-        };
-        let (a, b) = s.split_once(':').ok_or_else(|| bad("no ':'"))?;
-        let side = |t: &str, which: &str| -> Result<Option<f64>, AllanError> {
-            let t = t.trim();
-            if t.is_empty() {
-                return Ok(None);
-            }
-            let v: f64 = t
-                .parse()
-                .map_err(|_| bad(&format!("{which} {t:?} is not a number")))?;
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(&format!(
-                    "{which} must be a positive number of seconds"
-                )));
-            }
-            Ok(Some(v))
-        };
-        let spec = FitRangeSpec {
-            tau_min_s: side(a, "TMIN")?,
-            tau_max_s: side(b, "TMAX")?,
-        };
-        if let (Some(lo), Some(hi)) = (spec.tau_min_s, spec.tau_max_s)
-            && lo >= hi
-        {
-            return Err(bad("TMIN must be below TMAX"));
-        }
-        Ok(spec)
-    }
-}
-
-/// Largest averaging factor the automatic range may leave out: the sensor's own
-/// filtering acts over a few to a few tens of samples.
-pub const AUTO_RANGE_MAX_M: usize = 200;
-/// Smallest lag-1 autocorrelation of the τ-averaged rates that counts as coloured.
-pub const ACF_COLOURED: f64 = 0.02;
-
-/// Whether the shortest-τ point of a curve is coloured by the sensor's own filtering:
-/// the lag-1 autocorrelation r₁ of the rate samples lies above max([`ACF_COLOURED`],
-/// 3/√n) (white noise gives r₁ ≈ 0 with standard error 1/√n; Box & Jenkins 1976
-/// §2.1.6) or below −[`ACF_COLOURED`] while above −0.3 (a narrow-band hump; quantization
-/// alone gives r₁ → −½ and is a modelled term). `acf1` is the curve's
-/// [`crate::allan::analysis::ChannelResult::rate_acf1`], `n_samples` the samples behind it.
-pub fn short_tau_coloured(acf1: &[f64], n_samples: usize) -> bool {
-    let Some(&r) = acf1.first() else {
-        return false;
-    };
-    let limit = ACF_COLOURED.max(3.0 / (n_samples.max(1) as f64).sqrt());
-    r.is_finite() && (r > limit || (r < -limit && r > -0.3))
-}
-
-/// Candidate first points of the automatic fit range: the curve's first point, then
-/// points whose averaging factor m has grown by at least half since the previous
-/// candidate, up to m = [`AUTO_RANGE_MAX_M`].
-pub fn auto_range_candidates(m: &[usize]) -> Vec<usize> {
-    let mut out = Vec::new();
-    let mut last = 0usize;
-    for (i, &mi) in m.iter().enumerate() {
-        if mi > AUTO_RANGE_MAX_M {
-            break;
-        }
-        if out.is_empty() || 2 * mi >= 3 * last {
-            out.push(i);
-            last = mi;
-        }
-    }
-    out
-}
-
-/// Relative model-error floor f of the fit weights: var σ̂²_i = m_i²·(2/ν_i + f²), so a
-/// point never counts as more precise than f, whatever its EDF.
-pub const MODEL_ERROR_FLOOR: f64 = 0.003;
-
-/// Smallest Gauss-Markov correlation time, in sample intervals: a shorter one is white
-/// noise at every τ the curve has.
-pub const GM_MIN_SAMPLES: f64 = 5.0;
-/// Resolution of the Gauss-Markov correlation-time search in ln T (relative, so
-/// 1e-5·(1 + |ln T|): a few 0.01 % of T, far inside its interval).
-const GM_LN_T_TOL: f64 = 1e-5;
-/// Largest Gauss-Markov correlation time as a fraction of the record: a longer one is a
-/// random walk over the record and its σ and T cannot be separated.
-pub const GM_MAX_RECORD_FRACTION: f64 = 0.1;
-
-/// What the fit needs to know about the record beyond the curve.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FitOptions {
-    /// Sample interval, s (bounds the Gauss-Markov correlation time from below at
-    /// [`GM_MIN_SAMPLES`]·τ0).
-    pub tau0_s: Option<f64>,
-    /// Record length, s (bounds the Gauss-Markov correlation time from above at
-    /// [`GM_MAX_RECORD_FRACTION`] of it).
-    pub record_s: Option<f64>,
-    /// Relative model-error floor of the weights (see [`MODEL_ERROR_FLOOR`]).
-    pub model_error_floor: f64,
-}
-
-impl Default for FitOptions {
-    fn default() -> Self {
-        FitOptions {
-            tau0_s: None,
-            record_s: None,
-            model_error_floor: MODEL_ERROR_FLOOR,
-        }
-    }
-}
-
-impl NoiseFit {
-    /// Model Allan variance at `tau` from the fitted terms.
-    pub fn model_avar(&self, tau: f64) -> f64 {
-        let v = |t: &Option<Term>| t.map(|t| t.value).unwrap_or(0.0);
-        let (q, n, b, k, r) = (
-            v(&self.quantization),
-            v(&self.white),
-            v(&self.bias_instability),
-            v(&self.rate_random_walk),
-            v(&self.rate_ramp),
-        );
-        let mut s = 3.0 * q * q / (tau * tau)
-            + n * n / tau
-            + 2.0 * std::f64::consts::LN_2 / std::f64::consts::PI * b * b
-            + k * k * tau / 3.0
-            + r * r * tau * tau / 2.0;
-        if let Some(gm) = &self.gauss_markov {
-            s += gauss_markov_avar(gm.sigma.value, gm.tau_c_s.value, tau);
-        }
-        s
-    }
-
-    /// The band of Allan variances the stated intervals allow at `tau`: every term at
-    /// the lower end of its interval (undetected terms at zero), and every term at the
-    /// upper end (undetected terms at their upper limit; a Gauss-Markov term at the
-    /// correlation time within its interval that gives the most, resp. least). A
-    /// conservative envelope — the terms' errors are not all of one sign — for reading
-    /// where a model's intervals say another recording of the sensor may lie.
-    pub fn model_avar_band(&self, tau: f64) -> (f64, f64) {
-        let (mut lo, mut hi) = (0.0, 0.0);
-        for kind in TermKind::LINEAR {
-            let basis = kind.basis(tau);
-            if let Some(t) = self.term(kind) {
-                lo += t.lo * t.lo * basis;
-                hi += t.hi * t.hi * basis;
-            } else if let Some(u) = self.not_detected.iter().find(|u| u.term == kind)
-                && u.upper.is_finite()
-            {
-                hi += u.upper * u.upper * basis;
-            }
-        }
-        if let Some(g) = &self.gauss_markov {
-            let shapes = [g.tau_c_s.lo, g.tau_c_s.value, g.tau_c_s.hi]
-                .map(|tc| gauss_markov_avar(1.0, tc, tau))
-                .into_iter()
-                .filter(|v| v.is_finite());
-            let (smin, smax) =
-                shapes.fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
-            if smax > 0.0 {
-                lo += g.sigma.lo * g.sigma.lo * smin;
-                hi += g.sigma.hi * g.sigma.hi * smax;
-            }
-        } else if let Some(u) = self
-            .not_detected
-            .iter()
-            .find(|u| u.term == TermKind::GaussMarkov)
-            && u.upper.is_finite()
-        {
-            // No correlation time was fitted: the largest a σ at the upper limit can
-            // give at this τ is its peak over T (0.381·σ² at T ≈ τ/1.89).
-            hi += u.upper * u.upper * gauss_markov_avar_peak().1;
-        }
-        (lo, hi)
-    }
-
-    /// Removes the fitted term of a kind from the values.
-    pub fn clear_term(&mut self, kind: TermKind) {
-        match kind {
-            TermKind::Quantization => self.quantization = None,
-            TermKind::White => self.white = None,
-            TermKind::BiasInstability => self.bias_instability = None,
-            TermKind::RateRandomWalk => self.rate_random_walk = None,
-            TermKind::RateRamp => self.rate_ramp = None,
-            TermKind::GaussMarkov => self.gauss_markov = None,
-        }
-    }
-
-    /// The fitted term of a kind (Gauss-Markov: its σ).
-    pub fn term(&self, kind: TermKind) -> Option<Term> {
-        match kind {
-            TermKind::Quantization => self.quantization,
-            TermKind::White => self.white,
-            TermKind::BiasInstability => self.bias_instability,
-            TermKind::RateRandomWalk => self.rate_random_walk,
-            TermKind::RateRamp => self.rate_ramp,
-            TermKind::GaussMarkov => self.gauss_markov.map(|g| g.sigma),
-        }
-    }
-
-    /// The term contributing most Allan variance at `tau` (None if the model is empty).
-    pub fn dominant_term(&self, tau: f64) -> Option<TermKind> {
-        let mut best: Option<(TermKind, f64)> = None;
-        let mut consider = |k: TermKind, v: f64| {
-            if v > 0.0 && best.is_none_or(|(_, b)| v > b) {
-                best = Some((k, v));
-            }
-        };
-        for k in TermKind::LINEAR {
-            if let Some(t) = self.term(k) {
-                consider(k, t.value * t.value * k.basis(tau));
-            }
-        }
-        if let Some(gm) = &self.gauss_markov {
-            consider(
-                TermKind::GaussMarkov,
-                gauss_markov_avar(gm.sigma.value, gm.tau_c_s.value, tau),
-            );
-        }
-        best.map(|(k, _)| k)
-    }
-
-    /// Power-law exponent α (−2..=2) of the dominant term at `tau`, for choosing the EDF
-    /// of each Allan point. A Gauss-Markov term behaves like random walk (α = −2) well
-    /// below its correlation time, like white noise (α = 0) well above it and is given
-    /// α = −1 in between (0.3 T … 3 T). Empty model: 0.
-    pub fn dominant_alpha(&self, tau: f64) -> i32 {
-        match self.dominant_term(tau) {
-            None => 0,
-            Some(TermKind::GaussMarkov) => {
-                let t = self.gauss_markov.map(|g| g.tau_c_s.value).unwrap_or(1.0);
-                let u = tau / t;
-                if u < 0.3 {
-                    -2
-                } else if u > 3.0 {
-                    0
-                } else {
-                    -1
-                }
-            }
-            Some(k) => k.alpha(),
-        }
-    }
-}
 
 /// Allan variance of a first-order Gauss-Markov process with stationary σ and
 /// correlation time T (IEEE Std 952-1997 Annex C, exponentially correlated noise):
@@ -881,66 +327,23 @@ pub fn fit_noise_opts(
     let inflation = correlation_inflation(tau);
 
     // Optional Gauss-Markov: separable search over ln T.
-    let mut gm_t: Option<f64> = None;
-    if with_gm {
-        let (tmin, tmax) = tau
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(a, b), &t| (a.min(t), b.max(t)));
-        let t_lo = opts
-            .tau0_s
-            .map_or(tmin / 10.0, |t0| tmin.max(GM_MIN_SAMPLES * t0));
-        let t_hi = opts.record_s.map_or(tmax * 10.0, |r| {
-            (tmax * 10.0).min(GM_MAX_RECORD_FRACTION * r)
-        });
-        let (lo, hi) = (t_lo.ln(), t_hi.ln());
-        let objective = |lt: f64| -> f64 {
-            let mut c = cols.clone();
-            c.push(gm_column(tau, lt.exp()));
-            irls(&c, avar, edf, floor).chi2
-        };
-        let ngrid = 21;
-        let grid: Vec<f64> = (0..ngrid)
-            .map(|i| lo + (hi - lo) * i as f64 / (ngrid - 1) as f64)
-            .collect();
-        let vals: Vec<f64> = grid.iter().map(|&g| objective(g)).collect();
-        let ibest = vals
-            .iter()
-            .enumerate()
-            .min_by(|a, b| a.1.total_cmp(b.1))
-            .map(|(i, _)| i)
-            .unwrap_or(0);
-        let a = grid[ibest.saturating_sub(1)];
-        let b = grid[(ibest + 1).min(ngrid - 1)];
-        let (lt, _) = golden_max_tol(|x| -objective(x), a, b, GM_LN_T_TOL);
-        // Within 2 % of a bound: the curve wants a correlation time outside what the
-        // record can show.
-        if hi - lo < 0.1 || lt - lo < 0.02 || hi - lt < 0.02 {
-            let reason = if hi - lo >= 0.1 && lt - lo < 0.02 && (t_lo - tmin).abs() <= 1e-12 * tmin
-            {
-                format!(
-                    "no correlated hump: the best correlation time is below the fitted \
-                     range's first τ ({} s), where it is white noise",
-                    sig3(t_lo)
-                )
-            } else {
-                format!(
-                    "correlation time at the bound of its search ({} s; allowed {} … {} s: \
-                     at least {GM_MIN_SAMPLES} sample intervals and the range's first τ, at \
-                     most {GM_MAX_RECORD_FRACTION} of the record)",
-                    sig3(lt.exp()),
-                    sig3(t_lo),
-                    sig3(t_hi)
-                )
-            };
-            not_identifiable.push(NotIdentifiable {
-                term: TermKind::GaussMarkov,
-                reason,
-            });
-        } else {
-            gm_t = Some(lt.exp());
-            cols.push(gm_column(tau, lt.exp()));
+    let gm_t = if with_gm {
+        match gm_search(tau, avar, edf, &cols, floor, opts) {
+            Ok(t) => {
+                cols.push(gm_column(tau, t));
+                Some(t)
+            }
+            Err(reason) => {
+                not_identifiable.push(NotIdentifiable {
+                    term: TermKind::GaussMarkov,
+                    reason,
+                });
+                None
+            }
         }
-    }
+    } else {
+        None
+    };
 
     let sol = irls(&cols, avar, edf, floor);
     let n = tau.len();
@@ -999,63 +402,161 @@ pub fn fit_noise_opts(
         }),
         not_identifiable,
     };
-    let sq_term = |p: f64, var: f64| -> Term {
-        let s = (var * scale).max(0.0).sqrt();
+    let est = Estimates {
+        cols: &cols,
+        sol: &sol,
+        active: &active,
+        cov: cov.as_ref(),
+        z,
+        scale,
+    };
+    est.report_terms(&kinds, gm_t.map(|t| (t, gm_active)), &mut out);
+    Ok(out)
+}
+
+/// The Gauss-Markov correlation time that best fits the curve beside the linear terms
+/// `cols`: a grid over ln T refined by golden section, within the bounds the record allows
+/// ([`fit_noise_opts`]). A time at a bound of its search is an error saying why.
+fn gm_search(
+    tau: &[f64],
+    avar: &[f64],
+    edf: &[f64],
+    cols: &[Vec<f64>],
+    floor: f64,
+    opts: &FitOptions,
+) -> Result<f64, String> {
+    let (tmin, tmax) = tau
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &t| (a.min(t), b.max(t)));
+    let t_lo = opts
+        .tau0_s
+        .map_or(tmin / 10.0, |t0| tmin.max(GM_MIN_SAMPLES * t0));
+    let t_hi = opts.record_s.map_or(tmax * 10.0, |r| {
+        (tmax * 10.0).min(GM_MAX_RECORD_FRACTION * r)
+    });
+    let (lo, hi) = (t_lo.ln(), t_hi.ln());
+    let objective = |lt: f64| -> f64 {
+        let mut c = cols.to_vec();
+        c.push(gm_column(tau, lt.exp()));
+        irls(&c, avar, edf, floor).chi2
+    };
+    let ngrid = 21;
+    let grid: Vec<f64> = (0..ngrid)
+        .map(|i| lo + (hi - lo) * i as f64 / (ngrid - 1) as f64)
+        .collect();
+    let vals: Vec<f64> = grid.iter().map(|&g| objective(g)).collect();
+    let ibest = vals
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(i, _)| i)
+        .unwrap_or(0);
+    let a = grid[ibest.saturating_sub(1)];
+    let b = grid[(ibest + 1).min(ngrid - 1)];
+    let (lt, _) = golden_max_tol(|x| -objective(x), a, b, GM_LN_T_TOL);
+    // Within 2 % of a bound: the curve wants a correlation time outside what the
+    // record can show.
+    if hi - lo < 0.1 || lt - lo < 0.02 || hi - lt < 0.02 {
+        let reason = if hi - lo >= 0.1 && lt - lo < 0.02 && (t_lo - tmin).abs() <= 1e-12 * tmin {
+            format!(
+                "no correlated hump: the best correlation time is below the fitted \
+                     range's first τ ({} s), where it is white noise",
+                sig3(t_lo)
+            )
+        } else {
+            format!(
+                "correlation time at the bound of its search ({} s; allowed {} … {} s: \
+                     at least {GM_MIN_SAMPLES} sample intervals and the range's first τ, at \
+                     most {GM_MAX_RECORD_FRACTION} of the record)",
+                sig3(lt.exp()),
+                sig3(t_lo),
+                sig3(t_hi)
+            )
+        };
+        Err(reason)
+    } else {
+        Ok(lt.exp())
+    }
+}
+
+/// The solved fit and what its intervals need: the design columns, the IRLS solution, the
+/// active parameters and their covariance, the normal quantile and the variance scale.
+struct Estimates<'a> {
+    cols: &'a [Vec<f64>],
+    sol: &'a IrlsSolution,
+    active: &'a [usize],
+    cov: Option<&'a Vec<Vec<f64>>>,
+    z: f64,
+    scale: f64,
+}
+
+impl Estimates<'_> {
+    /// Interval of √p from the variance of p: p ± z·s clamped at zero, square-rooted.
+    fn sq_term(&self, p: f64, var: f64) -> Term {
+        let s = (var * self.scale).max(0.0).sqrt();
         Term {
             value: p.sqrt(),
-            lo: (p - z * s).max(0.0).sqrt(),
-            hi: (p + z * s).sqrt(),
+            lo: (p - self.z * s).max(0.0).sqrt(),
+            hi: (p + self.z * s).sqrt(),
         }
-    };
-    let var_of = |j: usize| -> f64 {
-        active
+    }
+
+    /// Variance of parameter `j` (NaN when inactive or without covariance).
+    fn var_of(&self, j: usize) -> f64 {
+        self.active
             .iter()
             .position(|&a| a == j)
-            .and_then(|pos| cov.as_ref().map(|c| c[pos][pos]))
+            .and_then(|pos| self.cov.map(|c| c[pos][pos]))
             .unwrap_or(f64::NAN)
-    };
-    for (j, &k) in kinds.iter().enumerate() {
-        if sol.coef[j] > 0.0 {
-            let t = sq_term(sol.coef[j], var_of(j));
-            match k {
-                TermKind::Quantization => out.quantization = Some(t),
-                TermKind::White => out.white = Some(t),
-                TermKind::BiasInstability => out.bias_instability = Some(t),
-                TermKind::RateRandomWalk => out.rate_random_walk = Some(t),
-                TermKind::RateRamp => out.rate_ramp = Some(t),
-                TermKind::GaussMarkov => {}
+    }
+
+    /// Fills the detected terms with their intervals and the undetected ones' upper limits;
+    /// `gm` is the Gauss-Markov correlation time and whether its σ² came out positive.
+    fn report_terms(&self, kinds: &[TermKind], gm: Option<(f64, bool)>, out: &mut NoiseFit) {
+        let (sol, z, scale) = (self.sol, self.z, self.scale);
+        for (j, &k) in kinds.iter().enumerate() {
+            if sol.coef[j] > 0.0 {
+                let t = self.sq_term(sol.coef[j], self.var_of(j));
+                match k {
+                    TermKind::Quantization => out.quantization = Some(t),
+                    TermKind::White => out.white = Some(t),
+                    TermKind::BiasInstability => out.bias_instability = Some(t),
+                    TermKind::RateRandomWalk => out.rate_random_walk = Some(t),
+                    TermKind::RateRamp => out.rate_ramp = Some(t),
+                    TermKind::GaussMarkov => {}
+                }
+            } else {
+                out.not_detected.push(UpperLimit {
+                    term: k,
+                    upper: upper_limit(self.cols, sol, j, z, scale),
+                });
             }
-        } else {
-            out.not_detected.push(UpperLimit {
-                term: k,
-                upper: upper_limit(&cols, &sol, j, z, scale),
-            });
+        }
+        let gm_index = kinds.len();
+        if let Some((t, gm_active)) = gm {
+            if gm_active {
+                let sigma = self.sq_term(sol.coef[gm_index], self.var_of(gm_index));
+                let var_lt = self
+                    .cov
+                    .map(|c| c[self.active.len()][self.active.len()])
+                    .unwrap_or(f64::NAN);
+                let s = (var_lt * scale).max(0.0).sqrt();
+                out.gauss_markov = Some(GaussMarkovTerm {
+                    sigma,
+                    tau_c_s: Term {
+                        value: t,
+                        lo: t * (-z * s).exp(),
+                        hi: t * (z * s).exp(),
+                    },
+                });
+            } else {
+                out.not_detected.push(UpperLimit {
+                    term: TermKind::GaussMarkov,
+                    upper: upper_limit(self.cols, sol, gm_index, z, scale),
+                });
+            }
         }
     }
-    if let Some(t) = gm_t {
-        if gm_active {
-            let sigma = sq_term(sol.coef[gm_index], var_of(gm_index));
-            let var_lt = cov
-                .as_ref()
-                .map(|c| c[active.len()][active.len()])
-                .unwrap_or(f64::NAN);
-            let s = (var_lt * scale).max(0.0).sqrt();
-            out.gauss_markov = Some(GaussMarkovTerm {
-                sigma,
-                tau_c_s: Term {
-                    value: t,
-                    lo: t * (-z * s).exp(),
-                    hi: t * (z * s).exp(),
-                },
-            });
-        } else {
-            out.not_detected.push(UpperLimit {
-                term: TermKind::GaussMarkov,
-                upper: upper_limit(&cols, &sol, gm_index, z, scale),
-            });
-        }
-    }
-    Ok(out)
 }
 
 /// [`fit_noise`] with the EDF of each point chosen from the power-law exponent α of the
@@ -1110,21 +611,6 @@ pub fn fit_noise_with_edf_opts<F: Fn(usize, i32) -> f64>(
     fit.ok_or_else(|| AllanError::Invalid("fit: no pass ran".into()))
 }
 
-/// α from the local log-log slope of the Allan variance (3-point centred differences).
-fn slope_alpha(tau: &[f64], avar: &[f64]) -> Vec<i32> {
-    let n = tau.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (i.saturating_sub(2), (i + 2).min(n.saturating_sub(1)));
-            if b <= a || tau[b] <= tau[a] || avar[a] <= 0.0 || avar[b] <= 0.0 {
-                return 0;
-            }
-            let mu = (avar[b] / avar[a]).ln() / (tau[b] / tau[a]).ln();
-            ((-mu - 1.0).round() as i32).clamp(-2, 2)
-        })
-        .collect()
-}
-
 /// Three significant digits for messages.
 fn sig3(v: f64) -> String {
     if v != 0.0 && (v.abs() >= 1e4 || v.abs() < 1e-2) {
@@ -1138,353 +624,9 @@ fn gm_column(tau: &[f64], t: f64) -> Vec<f64> {
     tau.iter().map(|&x| gauss_markov_avar(1.0, t, x)).collect()
 }
 
-struct IrlsSolution {
-    data: Vec<f64>,
-    coef: Vec<f64>,
-    model: Vec<f64>,
-    w: Vec<f64>,
-    chi2: f64,
-}
-
-/// Weight 1/var of an Allan-variance point with EDF ν and model value m: the χ² variance
-/// 2m²/ν (Greenhall & Riley 2003) plus the model-error floor (f·m)².
-fn weight(edf: f64, model: f64, floor: f64) -> f64 {
-    1.0 / (model * model * (2.0 / edf + floor * floor))
-}
-
-/// IRLS with model-based weights w_i = 1/(m_i²(2/ν_i + f²)) and an exact NNLS inside.
-fn irls(cols: &[Vec<f64>], avar: &[f64], edf: &[f64], floor: f64) -> IrlsSolution {
-    let n = avar.len();
-    let mut model = avar.to_vec();
-    let mut w = vec![0.0; n];
-    let mut coef = vec![0.0; cols.len()];
-    for _ in 0..200 {
-        for i in 0..n {
-            w[i] = weight(edf[i], model[i], floor);
-        }
-        coef = nnls(cols, avar, &w);
-        let mut change = 0.0f64;
-        for i in 0..n {
-            let m: f64 = cols.iter().zip(&coef).map(|(c, p)| c[i] * p).sum();
-            // Guard: an all-zero model (nothing detected) keeps a tiny positive weight base.
-            let m = m.max(1e-6 * avar[i]);
-            change = change.max(((m - model[i]) / model[i]).abs());
-            model[i] = m;
-        }
-        if change < 1e-10 {
-            break;
-        }
-    }
-    for i in 0..n {
-        w[i] = weight(edf[i], model[i], floor);
-    }
-    let chi2 = (0..n).map(|i| w[i] * (avar[i] - model[i]).powi(2)).sum();
-    IrlsSolution {
-        data: avar.to_vec(),
-        coef,
-        model,
-        w,
-        chi2,
-    }
-}
-
-/// Most columns of the small least-squares systems of the fit: five linear terms, the
-/// Gauss-Markov σ² and its ln T, with room to spare. The systems live on the stack: the
-/// fit solves thousands of them per channel (IRLS iterations × supports × the
-/// Gauss-Markov search), and allocating each cost more than solving it.
-const MAXP: usize = 8;
-
-/// Column-scaled weighted normal equations A_jk = Σ w c_j c_k/(s_j s_k),
-/// b_j = Σ w c_j y/s_j, yᵀWy, with s_j = √(Σ w c_j²) (unit diagonal, so a pivot test
-/// can tell near-collinear columns).
-struct NormalEquations {
-    p: usize,
-    a: [[f64; MAXP]; MAXP],
-    b: [f64; MAXP],
-    yy: f64,
-    s: [f64; MAXP],
-}
-
-/// The normal equations of `cols` (at most [`MAXP`]) against `y`, or None with more.
-fn normal_equations(cols: &[Vec<f64>], y: &[f64], w: &[f64]) -> Option<NormalEquations> {
-    let p = cols.len();
-    if p > MAXP {
-        return None;
-    }
-    let mut ne = NormalEquations {
-        p,
-        a: [[0.0; MAXP]; MAXP],
-        b: [0.0; MAXP],
-        yy: 0.0,
-        s: [1.0; MAXP],
-    };
-    for (j, c) in cols.iter().enumerate() {
-        let s = c.iter().zip(w).map(|(v, w)| w * v * v).sum::<f64>().sqrt();
-        ne.s[j] = if s > 0.0 && s.is_finite() { s } else { 1.0 };
-    }
-    for j in 0..p {
-        for k in 0..=j {
-            let v: f64 = (0..y.len())
-                .map(|i| w[i] * cols[j][i] * cols[k][i])
-                .sum::<f64>()
-                / (ne.s[j] * ne.s[k]);
-            ne.a[j][k] = v;
-            ne.a[k][j] = v;
-        }
-        ne.b[j] = (0..y.len()).map(|i| w[i] * cols[j][i] * y[i]).sum::<f64>() / ne.s[j];
-    }
-    ne.yy = (0..y.len()).map(|i| w[i] * y[i] * y[i]).sum();
-    Some(ne)
-}
-
-/// Cholesky solve of the sub-system of `a`, `b` on the columns `idx`; None if (near)
-/// singular: the scaled matrix has a unit diagonal, so a pivot below 1e-12 is a
-/// near-collinear support.
-fn solve_subset(a: &[[f64; MAXP]; MAXP], b: &[f64; MAXP], idx: &[usize]) -> Option<[f64; MAXP]> {
-    let n = idx.len();
-    let mut l = [[0.0; MAXP]; MAXP];
-    for i in 0..n {
-        for j in 0..=i {
-            let s: f64 = (0..j).map(|k| l[i][k] * l[j][k]).sum();
-            let aij = a[idx[i]][idx[j]];
-            if i == j {
-                let d = aij - s;
-                if d.is_nan() || d <= 1e-12 {
-                    return None;
-                }
-                l[i][i] = d.sqrt();
-            } else {
-                l[i][j] = (aij - s) / l[j][j];
-            }
-        }
-    }
-    let mut y = [0.0; MAXP];
-    for i in 0..n {
-        let s: f64 = (0..i).map(|k| l[i][k] * y[k]).sum();
-        y[i] = (b[idx[i]] - s) / l[i][i];
-    }
-    let mut x = [0.0; MAXP];
-    for i in (0..n).rev() {
-        let s: f64 = (i + 1..n).map(|k| l[k][i] * x[k]).sum();
-        x[i] = (y[i] - s) / l[i][i];
-    }
-    Some(x)
-}
-
-/// Exact non-negative weighted least squares for a handful of columns, by the active-set
-/// method of Lawson & Hanson (1974, ch. 23) on the normal equations (the form of Bro &
-/// De Jong 1997): move into the passive set the column whose gradient b − Ax is largest
-/// and positive, solve the passive sub-system, step back along the segment to the
-/// feasible region when a coefficient turns non-positive and release it; stop when no
-/// gradient is positive. The problem is convex, so this is the optimum the enumeration
-/// of every support would find, at a few sub-system solves instead of 2^p. A column
-/// nearly collinear with the passive set is left out.
-fn nnls(cols: &[Vec<f64>], y: &[f64], w: &[f64]) -> Vec<f64> {
-    let Some(ne) = normal_equations(cols, y, w) else {
-        return vec![0.0; cols.len()];
-    };
-    let p = ne.p;
-    let scale = ne.b[..p].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let tol = 1e-12 * (1.0 + scale);
-    let mut x = [0.0; MAXP];
-    let mut passive = [false; MAXP];
-    let mut barred = [false; MAXP];
-    let mut idx = [0usize; MAXP];
-    let gradient =
-        |x: &[f64; MAXP], j: usize| ne.b[j] - (0..p).map(|k| ne.a[j][k] * x[k]).sum::<f64>();
-    for _ in 0..(4 * MAXP) {
-        let Some(j) = (0..p)
-            .filter(|&j| !passive[j] && !barred[j])
-            .map(|j| (j, gradient(&x, j)))
-            .filter(|&(_, g)| g > tol)
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(j, _)| j)
-        else {
-            break;
-        };
-        passive[j] = true;
-        let mut entered = true;
-        for _ in 0..(4 * MAXP) {
-            let mut k = 0;
-            for (c, &on) in passive[..p].iter().enumerate() {
-                if on {
-                    idx[k] = c;
-                    k += 1;
-                }
-            }
-            let Some(sol) = solve_subset(&ne.a, &ne.b, &idx[..k]) else {
-                // Collinear with the passive set: leave the newcomer out for good.
-                passive[j] = false;
-                barred[j] = true;
-                entered = false;
-                break;
-            };
-            let mut z = [0.0; MAXP];
-            for t in 0..k {
-                z[idx[t]] = sol[t];
-            }
-            if idx[..k].iter().all(|&c| z[c] > 0.0) {
-                x = z;
-                break;
-            }
-            // Step from x towards z as far as feasibility allows.
-            let alpha = idx[..k]
-                .iter()
-                .filter(|&&c| z[c] <= 0.0)
-                .map(|&c| x[c] / (x[c] - z[c]))
-                .fold(f64::INFINITY, f64::min);
-            for &c in &idx[..k] {
-                x[c] += alpha * (z[c] - x[c]);
-                if x[c] <= tol {
-                    x[c] = 0.0;
-                    passive[c] = false;
-                }
-            }
-            if !passive[..p].iter().any(|&on| on) {
-                break;
-            }
-        }
-        if !entered {
-            continue;
-        }
-    }
-    // Undo the column scaling.
-    (0..p).map(|j| x[j].max(0.0) / ne.s[j]).collect()
-}
-
-/// (JᵀWJ)⁻¹ for the given Jacobian columns, None if singular.
-fn covariance(jac: &[Vec<f64>], w: &[f64]) -> Option<Vec<Vec<f64>>> {
-    let p = jac.len();
-    if p == 0 {
-        return Some(Vec::new());
-    }
-    let dummy = vec![0.0; w.len()];
-    let ne = normal_equations(jac, &dummy, w)?;
-    let all: Vec<usize> = (0..p).collect();
-    let mut inv = vec![vec![0.0; p]; p];
-    for k in 0..p {
-        let mut e = [0.0; MAXP];
-        e[k] = 1.0;
-        let col = solve_subset(&ne.a, &e, &all)?;
-        for j in 0..p {
-            inv[j][k] = col[j] / (ne.s[j] * ne.s[k]);
-        }
-    }
-    Some(inv)
-}
-
-/// Upper limit of a term fitted to zero: refit the final active set plus column `j`
-/// without the sign constraint at the final weights; upper = √(max(θ̂_j, 0) + z·s_j).
-fn upper_limit(cols: &[Vec<f64>], sol: &IrlsSolution, j: usize, z: f64, scale: f64) -> f64 {
-    let mut idx: Vec<usize> = (0..cols.len()).filter(|&k| sol.coef[k] > 0.0).collect();
-    idx.push(j);
-    let sub: Vec<Vec<f64>> = idx.iter().map(|&k| cols[k].clone()).collect();
-    let last = idx.len() - 1;
-    let all: Vec<usize> = (0..sub.len()).collect();
-    let Some(ne) = normal_equations(&sub, &sol.data, &sol.w) else {
-        return f64::NAN;
-    };
-    let (Some(x), Some(cov)) = (solve_subset(&ne.a, &ne.b, &all), covariance(&sub, &sol.w)) else {
-        return f64::NAN;
-    };
-    let theta = x[last] / ne.s[last];
-    let sd = (cov[last][last] * scale).max(0.0).sqrt();
-    (theta.max(0.0) + z * sd).sqrt()
-}
-
-/// Golden-section maximisation of a unimodal function on [a, b]; returns (x*, f(x*)).
-pub(crate) fn golden_max<F: Fn(f64) -> f64>(f: F, a: f64, b: f64) -> (f64, f64) {
-    golden_max_tol(f, a, b, 1e-10)
-}
-
-/// [`golden_max`] stopping when the bracket is narrower than `tol`·(1 + |a| + |b|).
-pub(crate) fn golden_max_tol<F: Fn(f64) -> f64>(f: F, a: f64, b: f64, tol: f64) -> (f64, f64) {
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut a, mut b) = (a.min(b), a.max(b));
-    let mut c = b - g * (b - a);
-    let mut d = a + g * (b - a);
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..80 {
-        if (b - a).abs() < tol * (1.0 + a.abs() + b.abs()) {
-            break;
-        }
-        if fc > fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
-    let x = 0.5 * (a + b);
-    (x, f(x))
-}
-
-// ---------------------------------------------------------------------------------------
-// Classic slope readings.
-
-/// The classic graphical readings of an Allan-deviation curve (IEEE Std 952-1997
-/// Fig. C.2; El-Sheimy et al. 2008): a diagnostic next to the full fit, which is
-/// considerably more accurate for K and B.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SlopeReadings {
-    /// N: value at τ = 1 s of the −½-slope line through the point whose local slope is
-    /// closest to −½ (None if no point has a slope within ±0.15 of −½), u·√s.
-    pub white: Option<f64>,
-    /// B = σ_min/0.664 if the minimum is interior to the curve, u.
-    pub bias_instability: Option<f64>,
-    /// τ of the minimum, s.
-    pub tau_min: Option<f64>,
-    /// K: value at τ = 3 s of the +½-slope line through the point whose local slope is
-    /// closest to +½ (None if none within ±0.15), u/√s.
-    pub rate_random_walk: Option<f64>,
-}
-
-/// Classic slope readings from an Allan **deviation** curve (ascending tau). Local slopes
-/// are centred log-log differences over ±2 points.
-pub fn slope_readings(tau: &[f64], adev: &[f64]) -> SlopeReadings {
-    let n = tau.len().min(adev.len());
-    let ok = |i: usize| tau[i] > 0.0 && adev[i] > 0.0 && tau[i].is_finite() && adev[i].is_finite();
-    let slope = |i: usize| -> Option<f64> {
-        let (a, b) = (i.saturating_sub(2), (i + 2).min(n.saturating_sub(1)));
-        if b <= a || !ok(a) || !ok(b) || tau[b] <= tau[a] {
-            return None;
-        }
-        Some((adev[b] / adev[a]).ln() / (tau[b] / tau[a]).ln())
-    };
-    let closest = |target: f64| -> Option<usize> {
-        (0..n)
-            .filter(|&i| ok(i))
-            .filter_map(|i| slope(i).map(|s| (i, (s - target).abs())))
-            .filter(|&(_, d)| d < 0.15)
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(i, _)| i)
-    };
-    let white = closest(-0.5).map(|i| adev[i] * tau[i].sqrt());
-    let rate_random_walk = closest(0.5).map(|i| adev[i] * (3.0 / tau[i]).sqrt());
-    let imin = (0..n)
-        .filter(|&i| ok(i))
-        .min_by(|&a, &b| adev[a].total_cmp(&adev[b]));
-    let (bias_instability, tau_min) = match imin {
-        Some(i) if i > 0 && i + 1 < n => (Some(adev[i] / BIAS_ADEV_FLOOR), Some(tau[i])),
-        _ => (None, None),
-    };
-    SlopeReadings {
-        white,
-        bias_instability,
-        tau_min,
-        rate_random_walk,
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use super::solve::{MAXP, nnls, normal_equations, solve_subset, weight};
     use super::*;
 
     fn taus(n: usize, lo: f64, hi: f64) -> Vec<f64> {

@@ -21,297 +21,41 @@
 //! Sources: IEEE Std 952-1997 Annex C; IEEE Std 1293-2018; El-Sheimy, Hou & Niu 2008;
 //! discrete Gauss-Markov: Gelb, *Applied Optimal Estimation* (1974) §4.4.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use driftless_model::units::{
-    DEG, DEG_PER_H, DEG_PER_H_PER_SQRT_H, DEG_PER_SQRT_H, HOUR_S, M_PER_S_PER_SQRT_H, MICRO_G,
-    MILLI_G,
-};
 use serde::{Deserialize, Serialize};
 
 use super::AllanError;
 use super::analysis::ChannelResult;
 use super::fit::{
-    BIAS_AVAR_COEF, CHI2_RED_GOOD, FitConfig, FitOptions, FitRange, FitRangeSpec,
-    MODEL_ERROR_FLOOR, NoiseFit, NotIdentifiable, RangeSource, SlopeReadings, Term, TermKind,
-    UpperLimit, auto_range_candidates, chi2_verdict, fit_noise_with_edf_opts,
-    gauss_markov_avar_peak, short_tau_coloured, slope_readings,
+    FitConfig, FitOptions, FitRange, FitRangeSpec, MODEL_ERROR_FLOOR, NoiseFit, NotIdentifiable,
+    RangeSource, SlopeReadings, TermKind, auto_range_candidates, fit_noise_with_edf_opts,
+    short_tau_coloured, slope_readings,
 };
 
-const ALL_TERMS: [TermKind; 6] = [
-    TermKind::Quantization,
-    TermKind::White,
-    TermKind::BiasInstability,
-    TermKind::RateRandomWalk,
-    TermKind::RateRamp,
-    TermKind::GaussMarkov,
-];
+mod discrete;
+mod display;
+mod file;
+mod selection;
+mod table;
 
-pub(crate) fn term_label(k: TermKind) -> &'static str {
-    match k {
-        TermKind::Quantization => "quantization Q",
-        TermKind::White => "white N",
-        TermKind::BiasInstability => "bias instab. B",
-        TermKind::RateRandomWalk => "rate rand. walk K",
-        TermKind::RateRamp => "rate ramp R",
-        TermKind::GaussMarkov => "GM sigma",
-    }
-}
-
-/// SI unit of each term for rate samples in `unit` (u·s, u·√s, u, u/√s, u/s).
-pub(crate) fn si_term_units(unit: &str) -> impl Fn(TermKind) -> String + '_ {
-    let u = if unit.is_empty() { "u" } else { unit };
-    move |k| match k {
-        TermKind::Quantization => format!("({u})·s"),
-        TermKind::White => format!("({u})·sqrt(s)"),
-        TermKind::BiasInstability | TermKind::GaussMarkov => u.to_string(),
-        TermKind::RateRandomWalk => format!("({u})/sqrt(s)"),
-        TermKind::RateRamp => format!("({u})/s"),
-    }
-}
-
-pub(crate) fn fmt_num(v: f64) -> String {
-    if v == 0.0 {
-        "0".into()
-    } else if !v.is_finite() {
-        format!("{v}")
-    } else if (1e-3..1e5).contains(&v.abs()) {
-        // five significant digits
-        let d = (4 - v.abs().log10().floor() as i32).clamp(0, 7) as usize;
-        format!("{v:.d$}")
-    } else {
-        format!("{v:.4e}")
-    }
-}
+pub use discrete::{
+    DiscreteGaussMarkov, DiscreteNoise, bias_floor_tau, discrete_noise, model_minimum_tau,
+};
+pub use display::{DisplayValue, display_terms, display_units};
+pub(crate) use display::{fmt_num, si_term_units, term_label};
+pub use selection::{
+    AUTO_RANGE_MIN_POINTS, CURVE_PRECISION, CURVE_PRECISION_CONFIDENCE,
+    QUANTIZATION_RESOLUTION_FACTOR, Unsupported, auto_fit_end, fit_supported_terms,
+    least_supported_term, widen_for_the_start,
+};
+use selection::{auto_range, user_indices};
+pub use table::fit_quality_lines;
 
 /// Current file format version.
 pub const FORMAT_VERSION: u32 = 1;
 
 pub use crate::io::Quantity;
-
-/// Display units of a term for a channel quantity: (unit name, size of one display unit
-/// in SI). Angular rate → gyro units, specific force → accelerometer units; other
-/// quantities have none (their terms stay in SI).
-pub fn display_units(quantity: Quantity, term: TermKind) -> &'static [(&'static str, f64)] {
-    GyroOrAccel::of(quantity).map_or(&[], |g| g.display_units(term))
-}
-
-#[derive(Clone, Copy)]
-enum GyroOrAccel {
-    Gyro,
-    Accel,
-}
-
-impl GyroOrAccel {
-    fn of(q: Quantity) -> Option<GyroOrAccel> {
-        match q {
-            Quantity::AngularRate => Some(GyroOrAccel::Gyro),
-            Quantity::SpecificForce => Some(GyroOrAccel::Accel),
-            Quantity::Temperature | Quantity::Other => None,
-        }
-    }
-
-    /// Display units of a term: (unit name, size of one display unit in SI).
-    fn display_units(self, term: TermKind) -> &'static [(&'static str, f64)] {
-        const DEG_PER_H2: f64 = DEG / (HOUR_S * HOUR_S);
-        const M_PER_S_PER_H15: f64 = 1.0 / (HOUR_S * 60.0);
-        match (self, term) {
-            (GyroOrAccel::Gyro, TermKind::Quantization) => &[("deg", DEG), ("urad", 1e-6)],
-            (GyroOrAccel::Gyro, TermKind::White) => {
-                &[("deg/sqrt(h)", DEG_PER_SQRT_H), ("deg/s/sqrt(Hz)", DEG)]
-            }
-            (GyroOrAccel::Gyro, TermKind::BiasInstability | TermKind::GaussMarkov) => {
-                &[("deg/h", DEG_PER_H)]
-            }
-            (GyroOrAccel::Gyro, TermKind::RateRandomWalk) => {
-                &[("deg/h/sqrt(h)", DEG_PER_H_PER_SQRT_H)]
-            }
-            (GyroOrAccel::Gyro, TermKind::RateRamp) => &[("deg/h^2", DEG_PER_H2)],
-            (GyroOrAccel::Accel, TermKind::Quantization) => &[("m/s", 1.0)],
-            (GyroOrAccel::Accel, TermKind::White) => &[
-                ("m/s/sqrt(h)", M_PER_S_PER_SQRT_H),
-                ("ug/sqrt(Hz)", MICRO_G),
-            ],
-            (GyroOrAccel::Accel, TermKind::BiasInstability | TermKind::GaussMarkov) => {
-                &[("ug", MICRO_G), ("mg", MILLI_G)]
-            }
-            (GyroOrAccel::Accel, TermKind::RateRandomWalk) => {
-                &[("m/s^2/sqrt(s)", 1.0), ("m/s/h^1.5", M_PER_S_PER_H15)]
-            }
-            (GyroOrAccel::Accel, TermKind::RateRamp) => &[("m/s^3", 1.0)],
-        }
-    }
-}
-
-/// One term in a display unit. A term that was fitted but not detected has
-/// `detected = false`, value = lo = 0 and `hi` = its upper limit.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct DisplayValue {
-    /// Which term.
-    pub term: TermKind,
-    /// Display unit.
-    pub unit: String,
-    /// Estimate.
-    pub value: f64,
-    /// Lower confidence bound.
-    pub lo: f64,
-    /// Upper confidence bound (upper limit when not detected).
-    pub hi: f64,
-    /// Whether the term was detected.
-    pub detected: bool,
-}
-
-/// Continuous-time terms of a fit in display units (every unit of
-/// [`display_units`]), detected terms first in model order, then upper limits.
-pub fn display_terms(fit: &NoiseFit, quantity: Quantity) -> Vec<DisplayValue> {
-    let mut out = Vec::new();
-    for kind in [
-        TermKind::Quantization,
-        TermKind::White,
-        TermKind::BiasInstability,
-        TermKind::RateRandomWalk,
-        TermKind::RateRamp,
-        TermKind::GaussMarkov,
-    ] {
-        let (t, detected) = match fit.term(kind) {
-            Some(t) => (t, true),
-            None => match fit.not_detected.iter().find(|u| u.term == kind) {
-                Some(u) => (
-                    Term {
-                        value: 0.0,
-                        lo: 0.0,
-                        hi: u.upper,
-                    },
-                    false,
-                ),
-                None => continue,
-            },
-        };
-        for &(unit, size) in display_units(quantity, kind) {
-            out.push(DisplayValue {
-                term: kind,
-                unit: unit.to_string(),
-                value: t.value / size,
-                lo: t.lo / size,
-                hi: t.hi / size,
-                detected,
-            });
-        }
-    }
-    out
-}
-
-/// Discrete first-order Gauss-Markov process b_{k+1} = φ b_k + w_k.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct DiscreteGaussMarkov {
-    /// Stationary σ_b, u.
-    pub sigma: f64,
-    /// Correlation time T_c, s.
-    pub tau_c_s: f64,
-    /// φ = e^{−Δt/T_c}.
-    pub phi: f64,
-    /// Std of the per-sample driving noise w_k, σ_b·√(1 − φ²), u.
-    pub sigma_w: f64,
-    /// Continuous driving-noise PSD q_c = 2σ_b²/T_c, u²/s.
-    pub q_c: f64,
-}
-
-impl DiscreteGaussMarkov {
-    /// Discretise (σ, T_c) at sample interval `dt`.
-    pub fn new(sigma: f64, tau_c_s: f64, dt: f64) -> DiscreteGaussMarkov {
-        let phi = (-dt / tau_c_s).exp();
-        DiscreteGaussMarkov {
-            sigma,
-            tau_c_s,
-            phi,
-            sigma_w: sigma * (1.0 - phi * phi).max(0.0).sqrt(),
-            q_c: 2.0 * sigma * sigma / tau_c_s,
-        }
-    }
-}
-
-/// Per-sample (discrete-time) noise parameters at the model's sample rate, SI units
-/// (u = rad/s or m/s²). `None` = term absent. See the module table.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct DiscreteNoise {
-    /// Sample rate the discrete values refer to, Hz.
-    pub sample_rate_hz: f64,
-    /// Std of the white noise on each rate sample, σ_d = N·√f_s, u.
-    pub white_sigma: Option<f64>,
-    /// Continuous white-noise PSD N² (two-sided), u²/Hz — for continuous-time filters.
-    pub white_psd: Option<f64>,
-    /// Std of the bias random-walk step per sample, K·√Δt, u.
-    pub rate_random_walk_sigma: Option<f64>,
-    /// Continuous PSD of the bias derivative K², u²/s.
-    pub rate_random_walk_psd: Option<f64>,
-    /// Std of the quantization noise of each integrated sample (angle/velocity), Q, u·s.
-    pub quantization_sigma: Option<f64>,
-    /// Bias change per sample from the rate ramp, R·Δt, u.
-    pub rate_ramp_per_sample: Option<f64>,
-    /// First-order Gauss-Markov stand-in for the bias instability: Allan-variance peak
-    /// (0.3811 σ_b² at τ = 1.893 T_c) equal to the floor (2 ln2/π)B² at the τ where the
-    /// fitted curve is lowest. An approximation: one GM reproduces the floor only near
-    /// that τ.
-    pub bias_instability_gm: Option<DiscreteGaussMarkov>,
-    /// The fitted Gauss-Markov term, discretised.
-    pub gauss_markov: Option<DiscreteGaussMarkov>,
-}
-
-/// Discrete per-sample parameters of a fit at sample rate `fs` (Hz).
-pub fn discrete_noise(fit: &NoiseFit, fs: f64) -> DiscreteNoise {
-    let dt = 1.0 / fs;
-    let v = |t: Option<Term>| t.map(|t| t.value);
-    let bias_instability_gm = v(fit.bias_instability).and_then(|b| {
-        let (u_peak, peak) = gauss_markov_avar_peak();
-        let tau_floor = bias_floor_tau(fit)?;
-        let sigma = (BIAS_AVAR_COEF * b * b / peak).sqrt();
-        Some(DiscreteGaussMarkov::new(sigma, tau_floor / u_peak, dt))
-    });
-    DiscreteNoise {
-        sample_rate_hz: fs,
-        white_sigma: v(fit.white).map(|n| n * fs.sqrt()),
-        white_psd: v(fit.white).map(|n| n * n),
-        rate_random_walk_sigma: v(fit.rate_random_walk).map(|k| k * dt.sqrt()),
-        rate_random_walk_psd: v(fit.rate_random_walk).map(|k| k * k),
-        quantization_sigma: v(fit.quantization),
-        rate_ramp_per_sample: v(fit.rate_ramp).map(|r| r * dt),
-        bias_instability_gm,
-        gauss_markov: fit
-            .gauss_markov
-            .map(|g| DiscreteGaussMarkov::new(g.sigma.value, g.tau_c_s.value, dt)),
-    }
-}
-
-/// τ of the fitted curve's floor when the fit saw it: the model minimum
-/// ([`model_minimum_tau`]) if it lies inside the fitted τ range, None beyond it (the
-/// floor's place, and so the correlation time of a Gauss-Markov stand-in, is then not
-/// known — without a rate random walk the minimum is only the scan's end).
-pub fn bias_floor_tau(fit: &NoiseFit) -> Option<f64> {
-    let t = model_minimum_tau(fit);
-    match fit.fit_range {
-        Some(r) if t > r.tau_max_s => None,
-        _ => Some(t),
-    }
-}
-
-/// τ (s) minimising the fitted Allan variance over 1e-4 … 1e7 s (log-spaced scan then
-/// golden refinement). With only white + bias + RRW this is √3·N/K.
-pub fn model_minimum_tau(fit: &NoiseFit) -> f64 {
-    let f = |lt: f64| fit.model_avar(lt.exp());
-    let (lo, hi) = (1e-4f64.ln(), 1e7f64.ln());
-    let n = 221;
-    let mut best = (lo, f64::INFINITY);
-    for i in 0..n {
-        let x = lo + (hi - lo) * i as f64 / (n - 1) as f64;
-        let v = f(x);
-        if v < best.1 {
-            best = (x, v);
-        }
-    }
-    let step = (hi - lo) / (n - 1) as f64;
-    let (x, _) = super::fit::golden_max(|x| -f(x), best.0 - step, best.0 + step);
-    x.exp()
-}
 
 /// One channel of a noise model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -438,313 +182,6 @@ impl Default for ModelOptions {
     }
 }
 
-/// Relative half-width of the 68.3 % interval of σ̂(τ) up to which the automatic fit
-/// range reaches: a model can be held to ±10 % of the curve only where the curve itself
-/// is known to 10 %.
-pub const CURVE_PRECISION: f64 = 0.10;
-/// Confidence level of the curve interval [`CURVE_PRECISION`] applies to (one σ).
-pub const CURVE_PRECISION_CONFIDENCE: f64 = 0.683;
-
-/// Fewest curve points the automatic range keeps, whatever their precision.
-pub const AUTO_RANGE_MIN_POINTS: usize = 12;
-
-/// End (exclusive) of the automatic fit range: before the first point whose 68.3 %
-/// interval reaches beyond ±`precision` of σ̂, with the EDF ν of the long-τ noise types
-/// (flicker and random-walk FM, the smaller of the two, so that the end does not depend
-/// on a noise identification that is itself uncertain at long τ). σ̂² is ≈ σ²·χ²_ν/ν, so
-/// the interval's wider, upper side is σ̂·√(ν/χ²_ν(0.1587)) (NIST SP 1065 §5.3); it stays
-/// within +10 % for ν ≳ 68 — a few tens of independent averages. Beyond it the points
-/// scatter by more than the tolerance a model is held to, and on real sensors the
-/// longest τ carry slow effects (temperature, run-to-run changes of the bias) that no
-/// stationary term describes; they stay on the curve, with their intervals, but do not
-/// shape the model. At least [`AUTO_RANGE_MIN_POINTS`]
-/// points are kept.
-pub fn auto_fit_end(c: &ChannelResult, precision: f64) -> usize {
-    let n = c.points.len();
-    // The lower χ² point of the two-sided interval (Wilson–Hilferty: a few 0.1 % at the
-    // ν of a few tens this decides at).
-    let z_lo = super::fit::normal_quantile(0.5 * (1.0 - CURVE_PRECISION_CONFIDENCE));
-    let end = (0..n)
-        .position(|i| {
-            let nu = c.edf_for_alpha(i, -1).min(c.edf_for_alpha(i, -2));
-            !(nu.is_finite()
-                && nu > 0.0
-                && (nu / super::checks::chi2_quantile(nu, z_lo)).sqrt() <= 1.0 + precision)
-        })
-        .unwrap_or(n);
-    end.max(AUTO_RANGE_MIN_POINTS).min(n)
-}
-
-/// Quantization above this multiple of Δτ0/√12 is not taken as quantization.
-pub const QUANTIZATION_RESOLUTION_FACTOR: f64 = 3.0;
-
-/// The curve points inside a user range, [i0, i1).
-fn user_indices(c: &ChannelResult, r: FitRangeSpec) -> Result<(usize, usize), AllanError> {
-    let n = c.points.len();
-    let tol = 1e-9;
-    let lo = r.tau_min_s.map_or(0.0, |t| t * (1.0 - tol));
-    let hi = r.tau_max_s.map_or(f64::INFINITY, |t| t * (1.0 + tol));
-    let i0 = c.points.iter().position(|p| p.tau >= lo).unwrap_or(n);
-    let i1 = c
-        .points
-        .iter()
-        .rposition(|p| p.tau <= hi)
-        .map_or(0, |i| i + 1);
-    if i1 <= i0 {
-        return Err(AllanError::Invalid(format!(
-            "channel '{}': no curve point inside the fit range (the curve spans {} … {} s)",
-            c.name,
-            fmt_num(c.points.first().map_or(0.0, |p| p.tau)),
-            fmt_num(c.points.last().map_or(0.0, |p| p.tau))
-        )));
-    }
-    Ok((i0, i1))
-}
-
-/// Widens the interval of the white-noise term — the term the start of the range
-/// decides — by the bias the sensor's filtering may leave at the start. That leftover
-/// decays as 1/τ (a low-pass of time constant T_f changes σ²(τ) of white noise by
-/// ≈ −3N²T_f/τ²; a decimation filter's is of the same form), so the bias of the fitted
-/// θ = N² from a start τ_s is b(τ_s) ∝ 1/τ_s, and the fit from the next start r·τ_s
-/// (`later`, r = `ratio` > 1) differs from the one from τ_s (`at_start`, same terms) by
-/// Δ = θ_later − θ_start = −b(τ_s)·(1 − 1/r); hence b(τ_s) = −Δ·r/(r − 1) (Richardson's
-/// extrapolation). The bias is systematic and its sign known, so the interval is
-/// extended on that side by |b| (added to the statistical half-width, not in
-/// quadrature); the value itself is left as fitted.
-pub fn widen_for_the_start(fit: &mut NoiseFit, at_start: &NoiseFit, later: &NoiseFit, ratio: f64) {
-    let (Some(t), Some(s0), Some(l)) = (fit.white.as_mut(), at_start.white, later.white) else {
-        return;
-    };
-    if !(ratio.is_finite() && ratio > 1.0) {
-        return;
-    }
-    let theta = t.value * t.value;
-    let (lo, hi) = (t.lo * t.lo, t.hi * t.hi);
-    // The truth lies on the side the later start moves towards.
-    let shift = (l.value * l.value - s0.value * s0.value) * ratio / (ratio - 1.0);
-    if !(shift.is_finite() && lo.is_finite() && hi.is_finite() && lo <= theta && theta <= hi) {
-        return;
-    }
-    if shift > 0.0 {
-        t.hi = (hi + shift).sqrt();
-    } else {
-        t.lo = (lo + shift).max(0.0).sqrt();
-    }
-}
-
-/// The automatic fit range: the fit from each candidate first point (shortest first)
-/// to the curve's end; the first whose χ²_red is at most [`CHI2_RED_GOOD`] over the whole
-/// range *and* over its first half decade (`head(i0, fit)`: where a filter's leftover
-/// shows, and where the whole-range χ²_red would dilute it) — the widest range over which
-/// the model follows the curve within its uncertainty — or, if none is, the candidate
-/// with the smallest χ²_red.
-fn auto_range<F, H>(
-    candidates: &[usize],
-    n: usize,
-    fit_over: &F,
-    head: &H,
-) -> Result<(usize, usize, RangeSource, NoiseFit), AllanError>
-where
-    F: Fn(usize, usize) -> Result<NoiseFit, AllanError>,
-    H: Fn(usize, &NoiseFit) -> f64,
-{
-    let mut best: Option<(usize, NoiseFit)> = None;
-    let mut first_err = None;
-    for &i0 in candidates {
-        match fit_over(i0, n) {
-            Ok(f) => {
-                let good = f.chi2_reduced <= CHI2_RED_GOOD && head(i0, &f) <= CHI2_RED_GOOD;
-                if best
-                    .as_ref()
-                    .is_none_or(|(_, b)| f.chi2_reduced < b.chi2_reduced)
-                {
-                    best = Some((i0, f));
-                }
-                if good {
-                    break;
-                }
-            }
-            Err(e) => {
-                first_err.get_or_insert(e);
-            }
-        }
-    }
-    match (best, first_err) {
-        (Some((i0, f)), _) => {
-            let source = if i0 == 0 {
-                RangeSource::Full
-            } else {
-                RangeSource::Auto
-            };
-            Ok((i0, n, source, f))
-        }
-        (None, Some(e)) => Err(e),
-        (None, None) => Err(AllanError::Invalid("no curve point to fit".into())),
-    }
-}
-
-/// What a term the data do not support is reported as instead of a value.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Unsupported {
-    /// Its interval reaches zero: the upper end of the interval is the upper limit.
-    UpperLimit(UpperLimit),
-    /// Its value cannot be what the term describes (see [`least_supported_term`]).
-    NotIdentifiable(NotIdentifiable),
-}
-
-/// The term of `fit` the data support least, if any does not stand:
-/// * a quantization above [`QUANTIZATION_RESOLUTION_FACTOR`]·Δτ0/√12 — what angle
-///   increments quantized at the rate resolution step Δ = `step` would give (IEEE Std
-///   952-1997 C.1) — is not quantization (filtering, a spectral hump): not identifiable;
-/// * otherwise, of the terms whose interval reaches zero, the one with the smallest
-///   significance θ/(z·s_θ) (θ the squared coefficient, z·s_θ its interval half-width,
-///   so θ/(z·s_θ) = v²/(hi² − v²)): an upper limit at its interval's upper end.
-pub fn least_supported_term(
-    fit: &NoiseFit,
-    step: Option<f64>,
-    tau0_s: f64,
-) -> Option<(TermKind, Unsupported)> {
-    if let (Some(q), Some(step)) = (fit.quantization, step) {
-        let implied = step * tau0_s / 12f64.sqrt();
-        if q.value > QUANTIZATION_RESOLUTION_FACTOR * implied {
-            return Some((
-                TermKind::Quantization,
-                Unsupported::NotIdentifiable(NotIdentifiable {
-                    term: TermKind::Quantization,
-                    reason: format!(
-                        "{:.1}x what the resolution step {} implies ({} (u)·s): the short-τ \
-                         rise is not quantization (filtering, a spectral hump)",
-                        q.value / implied,
-                        fmt_num(step),
-                        fmt_num(implied)
-                    ),
-                }),
-            ));
-        }
-    }
-    let significance = |t: &Term| {
-        let half = t.hi * t.hi - t.value * t.value;
-        if half > 0.0 {
-            t.value * t.value / half
-        } else {
-            f64::INFINITY
-        }
-    };
-    let mut candidates: Vec<(TermKind, Term)> = TermKind::LINEAR
-        .into_iter()
-        .filter_map(|k| fit.term(k).map(|t| (k, t)))
-        .collect();
-    if let Some(g) = fit.gauss_markov {
-        candidates.push((TermKind::GaussMarkov, g.sigma));
-    }
-    candidates
-        .into_iter()
-        .filter(|(_, t)| t.lo <= 0.0)
-        .min_by(|a, b| significance(&a.1).total_cmp(&significance(&b.1)))
-        .map(|(kind, t)| {
-            (
-                kind,
-                Unsupported::UpperLimit(UpperLimit {
-                    term: kind,
-                    upper: t.hi,
-                }),
-            )
-        })
-}
-
-/// The fit with physically possible, resolved terms only, by backward elimination: fit
-/// with `cfg`, drop the [`least_supported_term`], refit without it and repeat until every
-/// remaining term stands. Each dropped term is reported (upper limit or not
-/// identifiable) from the fit that still had it; the returned fit's values, χ²_red and
-/// model curve are those of the terms that stand, so the saved model is the model
-/// that was fitted. `fit_with(cfg)` fits the curve with the terms `cfg` switches on.
-pub fn fit_supported_terms<F>(
-    cfg: &FitConfig,
-    step: Option<f64>,
-    tau0_s: f64,
-    fit_with: F,
-) -> Result<NoiseFit, AllanError>
-where
-    F: Fn(&FitConfig) -> Result<NoiseFit, AllanError>,
-{
-    let mut cfg = *cfg;
-    let mut dropped: Vec<Unsupported> = Vec::new();
-    let mut fit = fit_with(&cfg)?;
-    while let Some((kind, why)) = least_supported_term(&fit, step, tau0_s) {
-        dropped.push(why);
-        let next = cfg.without(kind);
-        let refit = if next.linear_terms().is_empty() && !next.gauss_markov {
-            None
-        } else {
-            fit_with(&next).ok()
-        };
-        match refit {
-            Some(f) => {
-                fit = f;
-                cfg = next;
-            }
-            None => {
-                // Nothing left to refit with: report the term and leave it out.
-                fit.clear_term(kind);
-                break;
-            }
-        }
-    }
-    for d in dropped {
-        match d {
-            Unsupported::UpperLimit(u) => {
-                fit.not_detected.retain(|x| x.term != u.term);
-                fit.not_detected.push(u);
-            }
-            Unsupported::NotIdentifiable(n) => fit.not_identifiable.push(n),
-        }
-    }
-    Ok(fit)
-}
-
-/// The fit range, χ²_red and its verdict, as printed under each channel.
-pub fn fit_quality_lines(fit: &NoiseFit) -> String {
-    let mut s = String::new();
-    if let Some(r) = &fit.fit_range {
-        let how = match r.source {
-            RangeSource::Full => "the whole curve".to_string(),
-            RangeSource::User => "set by --fit-range".to_string(),
-            RangeSource::Auto => {
-                let mut why = Vec::new();
-                if r.excluded_short > 0 {
-                    why.push(format!(
-                        "{} short-tau point(s) left out, where the sensor's own filtering \
-                         colours the noise and the model does not apply",
-                        r.excluded_short
-                    ));
-                }
-                if r.excluded_long > 0 {
-                    why.push(format!(
-                        "{} long-tau point(s) left out, known to worse than {:.0} % (too few \
-                         averages to hold a model to)",
-                        r.excluded_long,
-                        100.0 * CURVE_PRECISION
-                    ));
-                }
-                format!("automatic: {}", why.join("; "))
-            }
-        };
-        s.push_str(&format!(
-            "  fit range {} … {} s ({} points; {how})\n",
-            fmt_num(r.tau_min_s),
-            fmt_num(r.tau_max_s),
-            fit.n_points
-        ));
-    }
-    let (verdict, warn) = chi2_verdict(fit.chi2_reduced);
-    s.push_str(&format!(
-        "  chi2_red {} — {}{verdict}\n",
-        fmt_num(fit.chi2_reduced),
-        if warn { "WARNING: " } else { "" }
-    ));
-    s
-}
-
 impl NoiseModel {
     /// New empty model.
     pub fn new(
@@ -824,132 +261,16 @@ impl NoiseModel {
         let estimator = curves.first().map(|c| c.estimator.name().to_string());
         let mut model = NoiseModel::new(Some(source.to_string()), fs, estimator);
         for (k, (c, &q)) in curves.iter().zip(quantities).enumerate() {
-            let tau: Vec<f64> = c.points.iter().map(|p| p.tau).collect();
-            let avar: Vec<f64> = c.points.iter().map(|p| p.dev * p.dev).collect();
-            let adev: Vec<f64> = c.points.iter().map(|p| p.dev).collect();
-            let samples: usize = c
-                .segment_phase_points
-                .iter()
-                .map(|n| n.saturating_sub(1))
-                .sum();
-            let fit_opts = FitOptions {
-                tau0_s: Some(c.tau0_s),
-                record_s: Some(samples as f64 * c.tau0_s),
-                model_error_floor: opts.model_error_floor,
-            };
-            let step = opts.resolution.get(k).copied().flatten();
-            // EDF of every point for every noise exponent, once: the fits below ask for
-            // them thousands of times.
-            let edf_table: Vec<[f64; 5]> = (0..tau.len())
-                .map(|i| [-2, -1, 0, 1, 2].map(|a| c.edf_for_alpha(i, a)))
-                .collect();
-            let edf_of = |i: usize, alpha: i32| edf_table[i][(alpha.clamp(-2, 2) + 2) as usize];
-            let fit_with = |i0: usize, i1: usize, cfg: &FitConfig| {
-                if i0 >= i1 || i1 > tau.len() {
-                    return Err(AllanError::Invalid(format!(
-                        "no curve point between τ index {i0} and {i1}"
-                    )));
-                }
-                fit_supported_terms(cfg, step, c.tau0_s, |cfg| {
-                    fit_noise_with_edf_opts(
-                        &tau[i0..i1],
-                        &avar[i0..i1],
-                        |i, a| edf_of(i0 + i, a),
-                        cfg,
-                        confidence,
-                        &fit_opts,
-                    )
-                })
-            };
-            let fit_over = |i0: usize, i1: usize| fit_with(i0, i1, cfg);
-            // The start is searched with the linear terms only: it is decided by the
-            // short τ, and a Gauss-Markov search per candidate would cost tens of times
-            // the rest of the fit.
-            let search_cfg = if cfg.linear_terms().is_empty() {
-                *cfg
-            } else {
-                FitConfig {
-                    gauss_markov: false,
-                    ..*cfg
-                }
-            };
-            let search_over = |i0: usize, i1: usize| fit_with(i0, i1, &search_cfg);
-            let named = |e: AllanError, user: bool| {
-                AllanError::Invalid(format!(
-                    "noise fit of channel '{}': {e}{}",
-                    c.name,
-                    if user {
-                        " (choose a wider --fit-range)"
-                    } else {
-                        ""
-                    }
-                ))
-            };
-            let n = opts
-                .curve_precision
-                .map_or(tau.len(), |p| auto_fit_end(c, p));
+            let ch = ChannelFit::new(c, cfg, confidence, opts, k);
             let (i0, i1, source, mut fit) = match opts.fit_range {
                 Some(r) => {
                     let (i0, i1) = user_indices(c, r)?;
-                    let f = fit_over(i0, i1).map_err(|e| named(e, true))?;
+                    let f = ch.fit_over(i0, i1).map_err(|e| ch.named(e, true))?;
                     (i0, i1, RangeSource::User, f)
                 }
-                None => {
-                    let longest = c
-                        .segment_phase_points
-                        .iter()
-                        .max()
-                        .map_or(0, |n| n.saturating_sub(1));
-                    let coloured = short_tau_coloured(
-                        &c.rate_acf1,
-                        longest.min(super::analysis::MAX_ACF_BLOCKS),
-                    );
-                    let m: Vec<usize> = c.points.iter().map(|p| p.m).collect();
-                    // Mean squared normalised residual over points `idx`, with the
-                    // fit's own weights.
-                    let msr = |idx: &mut dyn Iterator<Item = usize>, f: &NoiseFit| -> f64 {
-                        let (mut sum, mut k) = (0.0, 0usize);
-                        for i in idx {
-                            let model = f.model_avar(tau[i]);
-                            let nu = edf_of(i, f.dominant_alpha(tau[i]));
-                            if model > 0.0 && nu > 0.0 {
-                                let var =
-                                    model * model * (2.0 / nu + opts.model_error_floor.powi(2));
-                                sum += (avar[i] - model).powi(2) / var;
-                                k += 1;
-                            }
-                        }
-                        if k == 0 { 0.0 } else { sum / k as f64 }
-                    };
-                    // The first half decade of the range, where a filter's leftover shows.
-                    let head = |i0: usize, f: &NoiseFit| {
-                        msr(&mut (i0..n).take_while(|&i| tau[i] <= 3.0 * tau[i0]), f)
-                    };
-                    if coloured {
-                        let candidates: Vec<usize> = auto_range_candidates(&m)
-                            .into_iter()
-                            .filter(|&i0| i0 < n)
-                            .collect();
-                        let (i0, i1, src, found) = auto_range(&candidates, n, &search_over, &head)
-                            .map_err(|e| named(e, false))?;
-                        let mut f = if search_cfg == *cfg {
-                            found.clone()
-                        } else {
-                            fit_over(i0, i1).map_err(|e| named(e, false))?
-                        };
-                        // The leftover of the sensor's filtering at the chosen start.
-                        if let Some(&next) = candidates.iter().find(|&&j| j > i0 && j + 1 < i1)
-                            && let Ok(later) = search_over(next, i1)
-                        {
-                            widen_for_the_start(&mut f, &found, &later, tau[next] / tau[i0]);
-                        }
-                        (i0, i1, src, f)
-                    } else {
-                        let f = fit_over(0, n).map_err(|e| named(e, false))?;
-                        (0, n, RangeSource::Full, f)
-                    }
-                }
+                None => ch.auto_fit()?,
             };
+            let tau = &ch.tau;
             let source = if source == RangeSource::Full && i1 < tau.len() {
                 RangeSource::Auto
             } else {
@@ -962,210 +283,208 @@ impl NoiseModel {
                 excluded_short: i0,
                 excluded_long: tau.len() - i1,
             });
-            let mut ch = ChannelNoise::new(&c.name, q, fit, 1.0 / c.tau0_s);
-            if ch.fit.bias_instability.is_some() && ch.discrete.bias_instability_gm.is_none() {
-                ch.fit.not_identifiable.push(NotIdentifiable {
+            let mut noise = ChannelNoise::new(&c.name, q, fit, 1.0 / c.tau0_s);
+            if noise.fit.bias_instability.is_some() && noise.discrete.bias_instability_gm.is_none()
+            {
+                noise.fit.not_identifiable.push(NotIdentifiable {
                     term: TermKind::BiasInstability,
                     reason: "its Gauss-Markov stand-in: the model's floor lies beyond the \
                              fitted range, so its correlation time is unknown (B itself stands)"
                         .into(),
                 });
             }
-            ch.slope_readings = Some(slope_readings(&tau, &adev));
-            model.channels.push(ch);
+            let adev: Vec<f64> = c.points.iter().map(|p| p.dev).collect();
+            noise.slope_readings = Some(slope_readings(tau, &adev));
+            model.channels.push(noise);
         }
         Ok(model)
     }
+}
 
-    /// Human-readable summary: per channel the continuous terms in display units with
-    /// their intervals, upper limits of undetected terms, and the per-sample discrete σ.
-    pub fn human_table(&self) -> String {
-        let mut s = String::new();
-        let conf = self
-            .channels
-            .first()
-            .map_or(0.0, |c| 100.0 * c.fit.confidence);
-        s.push_str(&format!(
-            "Noise terms (IEEE 952 fit, {conf:.1} % intervals). Continuous-time densities first; \
-             'discrete' lines are per-sample values at {} Hz.\n",
-            fmt_num(self.sample_rate_hz)
-        ));
-        for c in &self.channels {
-            s.push_str(&format!(
-                "\n{} [{}]\n",
-                c.name,
-                if c.unit.is_empty() {
-                    "data units"
-                } else {
-                    &c.unit
-                }
-            ));
-            s.push_str(&fit_quality_lines(&c.fit));
-            s.push_str(&format!(
-                "  {:<18} {:>11} {:>11} {:>11}  {}\n",
-                "term", "value", "lo", "hi", "unit"
-            ));
-            let mut rows: Vec<(String, f64, f64, f64, String)> = Vec::new();
-            let si_units = si_term_units(&c.unit);
-            for k in ALL_TERMS {
-                let label = term_label(k);
-                if let Some(t) = c.fit.term(k) {
-                    match display_units(c.quantity, k).first() {
-                        Some(&(u, size)) => rows.push((
-                            label.into(),
-                            t.value / size,
-                            t.lo / size,
-                            t.hi / size,
-                            u.into(),
-                        )),
-                        None => rows.push((label.into(), t.value, t.lo, t.hi, si_units(k))),
-                    }
-                }
-                if k == TermKind::GaussMarkov
-                    && let Some(g) = &c.fit.gauss_markov
-                {
-                    let t = g.tau_c_s;
-                    rows.push(("GM corr. time".into(), t.value, t.lo, t.hi, "s".into()));
-                }
-            }
-            for (label, v, lo, hi, u) in rows {
-                s.push_str(&format!(
-                    "  {:<18} {:>11} {:>11} {:>11}  {}\n",
-                    label,
-                    fmt_num(v),
-                    fmt_num(lo),
-                    fmt_num(hi),
-                    u
-                ));
-            }
-            for u in &c.fit.not_detected {
-                let (val, unit) = match display_units(c.quantity, u.term).first() {
-                    Some(&(name, size)) => (u.upper / size, name.to_string()),
-                    None => (u.upper, si_units(u.term)),
-                };
-                s.push_str(&format!(
-                    "  {:<18} not detected (< {} {})\n",
-                    term_label(u.term),
-                    fmt_num(val),
-                    unit
-                ));
-            }
-            for u in &c.fit.not_identifiable {
-                s.push_str(&format!(
-                    "  {:<18} not identifiable: {}\n",
-                    term_label(u.term),
-                    u.reason
-                ));
-            }
-            let d = &c.discrete;
-            let su = if c.unit.is_empty() {
-                "u"
-            } else {
-                c.unit.as_str()
-            };
-            let mut parts = Vec::new();
-            if let Some(v) = d.white_sigma {
-                parts.push(format!("white σ_d = N·√fs = {} {su}", fmt_num(v)));
-            }
-            if let Some(v) = d.rate_random_walk_sigma {
-                parts.push(format!("RRW step σ = K·√Δt = {} {su}", fmt_num(v)));
-            }
-            if let Some(g) = &d.bias_instability_gm {
-                parts.push(format!(
-                    "bias-instability GM σ_b = {} {su}, T_c = {} s (φ = {}, σ_w = {} {su})",
-                    fmt_num(g.sigma),
-                    fmt_num(g.tau_c_s),
-                    fmt_num(g.phi),
-                    fmt_num(g.sigma_w)
-                ));
-            }
-            for p in parts {
-                s.push_str(&format!("  discrete: {p}\n"));
-            }
-        }
-        s
-    }
+/// One channel's curve prepared for fitting: τ, σ², the EDF of every point for every
+/// noise exponent, and what every fit of it shares.
+struct ChannelFit<'a> {
+    c: &'a ChannelResult,
+    tau: Vec<f64>,
+    avar: Vec<f64>,
+    /// EDF of every point for noise exponents −2 … 2, computed once: the fits ask for
+    /// them thousands of times.
+    edf_table: Vec<[f64; 5]>,
+    /// Resolution step of the channel, if known.
+    step: Option<f64>,
+    fit_opts: FitOptions,
+    cfg: &'a FitConfig,
+    /// The configuration the start is searched with: the linear terms only, since the
+    /// start is decided by the short τ and a Gauss-Markov search per candidate would cost
+    /// tens of times the rest of the fit.
+    search_cfg: FitConfig,
+    confidence: f64,
+    opts: &'a ModelOptions,
+}
 
-    /// Serialise to TOML.
-    pub fn to_toml_string(&self) -> Result<String, NoiseModelError> {
-        Ok(toml::to_string_pretty(self)?)
-    }
-
-    /// Parse from TOML (errors name the source as `<string>`).
-    pub fn from_toml_str(s: &str) -> Result<NoiseModel, NoiseModelError> {
-        Self::parse(s, Path::new("<string>"))
-    }
-
-    fn parse(s: &str, path: &Path) -> Result<NoiseModel, NoiseModelError> {
-        let m: NoiseModel = toml::from_str(s).map_err(|e| NoiseModelError::Parse {
-            path: path.to_path_buf(),
-            source: Box::new(e),
-        })?;
-        let invalid = |why: String| NoiseModelError::Invalid {
-            path: path.to_path_buf(),
-            why,
+impl<'a> ChannelFit<'a> {
+    fn new(
+        c: &'a ChannelResult,
+        cfg: &'a FitConfig,
+        confidence: f64,
+        opts: &'a ModelOptions,
+        k: usize,
+    ) -> Self {
+        let tau: Vec<f64> = c.points.iter().map(|p| p.tau).collect();
+        let avar: Vec<f64> = c.points.iter().map(|p| p.dev * p.dev).collect();
+        let samples: usize = c
+            .segment_phase_points
+            .iter()
+            .map(|n| n.saturating_sub(1))
+            .sum();
+        let fit_opts = FitOptions {
+            tau0_s: Some(c.tau0_s),
+            record_s: Some(samples as f64 * c.tau0_s),
+            model_error_floor: opts.model_error_floor,
         };
-        if m.format_version == 0 || m.format_version > FORMAT_VERSION {
-            return Err(invalid(format!(
-                "format_version {} is not supported (this build reads 1..={FORMAT_VERSION})",
-                m.format_version
-            )));
-        }
-        if !(m.sample_rate_hz.is_finite() && m.sample_rate_hz > 0.0) {
-            return Err(invalid(format!(
-                "sample_rate_hz must be > 0, got {}",
-                m.sample_rate_hz
-            )));
-        }
-        for c in &m.channels {
-            for k in [
-                TermKind::Quantization,
-                TermKind::White,
-                TermKind::BiasInstability,
-                TermKind::RateRandomWalk,
-                TermKind::RateRamp,
-                TermKind::GaussMarkov,
-            ] {
-                if let Some(t) = c.fit.term(k)
-                    && !(t.value.is_finite() && t.value >= 0.0)
-                {
-                    return Err(invalid(format!(
-                        "channel '{}': {} = {} is not a finite non-negative value",
-                        c.name,
-                        k.name(),
-                        t.value
-                    )));
-                }
+        let edf_table: Vec<[f64; 5]> = (0..tau.len())
+            .map(|i| [-2, -1, 0, 1, 2].map(|a| c.edf_for_alpha(i, a)))
+            .collect();
+        let search_cfg = if cfg.linear_terms().is_empty() {
+            *cfg
+        } else {
+            FitConfig {
+                gauss_markov: false,
+                ..*cfg
             }
+        };
+        ChannelFit {
+            c,
+            tau,
+            avar,
+            edf_table,
+            step: opts.resolution.get(k).copied().flatten(),
+            fit_opts,
+            cfg,
+            search_cfg,
+            confidence,
+            opts,
         }
-        Ok(m)
     }
 
-    /// Write the model to `path`.
-    pub fn save(&self, path: &Path) -> Result<(), NoiseModelError> {
-        let s = self.to_toml_string()?;
-        crate::io::output::write(path, s).map_err(|e| NoiseModelError::Write {
-            path: path.to_path_buf(),
-            source: e,
+    fn edf_of(&self, i: usize, alpha: i32) -> f64 {
+        self.edf_table[i][(alpha.clamp(-2, 2) + 2) as usize]
+    }
+
+    /// The supported terms of `cfg` fitted over points `i0..i1`.
+    fn fit_with(&self, i0: usize, i1: usize, cfg: &FitConfig) -> Result<NoiseFit, AllanError> {
+        let tau = &self.tau;
+        if i0 >= i1 || i1 > tau.len() {
+            return Err(AllanError::Invalid(format!(
+                "no curve point between τ index {i0} and {i1}"
+            )));
+        }
+        fit_supported_terms(cfg, self.step, self.c.tau0_s, |cfg| {
+            fit_noise_with_edf_opts(
+                &tau[i0..i1],
+                &self.avar[i0..i1],
+                |i, a| self.edf_of(i0 + i, a),
+                cfg,
+                self.confidence,
+                &self.fit_opts,
+            )
         })
     }
 
-    /// Read a model from `path`.
-    pub fn load(path: &Path) -> Result<NoiseModel, NoiseModelError> {
-        let s = crate::io::read_config_text(path, crate::io::MAX_CONFIG_BYTES).map_err(|e| {
-            NoiseModelError::Read {
-                path: path.to_path_buf(),
-                source: e,
+    /// The fit asked for, over points `i0..i1`.
+    fn fit_over(&self, i0: usize, i1: usize) -> Result<NoiseFit, AllanError> {
+        self.fit_with(i0, i1, self.cfg)
+    }
+
+    /// The fit the start is searched with, over points `i0..i1`.
+    fn search_over(&self, i0: usize, i1: usize) -> Result<NoiseFit, AllanError> {
+        self.fit_with(i0, i1, &self.search_cfg)
+    }
+
+    /// A fit error naming the channel (and, for a user range, what to change).
+    fn named(&self, e: AllanError, user: bool) -> AllanError {
+        AllanError::Invalid(format!(
+            "noise fit of channel '{}': {e}{}",
+            self.c.name,
+            if user {
+                " (choose a wider --fit-range)"
+            } else {
+                ""
             }
-        })?;
-        Self::parse(&s, path)
+        ))
+    }
+
+    /// Mean squared normalised residual over points `idx`, with the fit's own weights.
+    fn msr(&self, idx: &mut dyn Iterator<Item = usize>, f: &NoiseFit) -> f64 {
+        let (mut sum, mut k) = (0.0, 0usize);
+        for i in idx {
+            let model = f.model_avar(self.tau[i]);
+            let nu = self.edf_of(i, f.dominant_alpha(self.tau[i]));
+            if model > 0.0 && nu > 0.0 {
+                let var = model * model * (2.0 / nu + self.opts.model_error_floor.powi(2));
+                sum += (self.avar[i] - model).powi(2) / var;
+                k += 1;
+            }
+        }
+        if k == 0 { 0.0 } else { sum / k as f64 }
+    }
+
+    /// The automatic range: up to where the curve is known well enough, starting past the
+    /// short τ the sensor's filtering colours (when it does), with the start's leftover
+    /// widening the intervals.
+    fn auto_fit(&self) -> Result<(usize, usize, RangeSource, NoiseFit), AllanError> {
+        let (c, tau) = (self.c, &self.tau);
+        let n = self
+            .opts
+            .curve_precision
+            .map_or(tau.len(), |p| auto_fit_end(c, p));
+        let longest = c
+            .segment_phase_points
+            .iter()
+            .max()
+            .map_or(0, |n| n.saturating_sub(1));
+        let coloured =
+            short_tau_coloured(&c.rate_acf1, longest.min(super::analysis::MAX_ACF_BLOCKS));
+        if !coloured {
+            let f = self.fit_over(0, n).map_err(|e| self.named(e, false))?;
+            return Ok((0, n, RangeSource::Full, f));
+        }
+        let m: Vec<usize> = c.points.iter().map(|p| p.m).collect();
+        // The first half decade of the range, where a filter's leftover shows.
+        let head = |i0: usize, f: &NoiseFit| {
+            self.msr(&mut (i0..n).take_while(|&i| tau[i] <= 3.0 * tau[i0]), f)
+        };
+        let search_over = |i0: usize, i1: usize| self.search_over(i0, i1);
+        let candidates: Vec<usize> = auto_range_candidates(&m)
+            .into_iter()
+            .filter(|&i0| i0 < n)
+            .collect();
+        let (i0, i1, src, found) =
+            auto_range(&candidates, n, &search_over, &head).map_err(|e| self.named(e, false))?;
+        let mut f = if self.search_cfg == *self.cfg {
+            found.clone()
+        } else {
+            self.fit_over(i0, i1).map_err(|e| self.named(e, false))?
+        };
+        // The leftover of the sensor's filtering at the chosen start.
+        if let Some(&next) = candidates.iter().find(|&&j| j > i0 && j + 1 < i1)
+            && let Ok(later) = self.search_over(next, i1)
+        {
+            widen_for_the_start(&mut f, &found, &later, tau[next] / tau[i0]);
+        }
+        Ok((i0, i1, src, f))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::allan::fit::{GaussMarkovTerm, UpperLimit};
+    use crate::allan::fit::{
+        BIAS_AVAR_COEF, GaussMarkovTerm, Term, UpperLimit, gauss_markov_avar_peak,
+    };
+    use driftless_model::units::{
+        DEG_PER_H, DEG_PER_H_PER_SQRT_H, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H, MICRO_G,
+    };
 
     fn term(v: f64) -> Option<Term> {
         Some(Term {

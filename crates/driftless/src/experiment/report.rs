@@ -7,10 +7,11 @@
 //! the Monte Carlo per-run means.
 
 use super::monte_carlo::ExperimentResult;
-use super::run::{Case, Prepared};
+use super::run::{Case, Prepared, VehicleRun};
 use super::table::{Column, ratio_explanation, reversal_explanation, table_rows};
 use crate::io::nav::NavSolution;
 use crate::nav::earth::{meridian_radius_m, prime_vertical_radius_m};
+use crate::nav::outage::OutageWindow;
 use crate::report::experiment_plots::{
     FIGURE_WIDTH, GrowthCurves, error_growth_figure, fit_to_width, grouped_bars_figure,
     outage_bars_figure, trajectory_figure,
@@ -50,54 +51,7 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
     let run = &r.detailed;
     let windows = p.windows();
     let labels: Vec<String> = (1..=windows.len()).map(|i| format!("#{i}")).collect();
-    if let Some(reference) = &run.reference
-        && !reference.time_s.is_empty()
-    {
-        let origin = (
-            reference.lat_rad[0],
-            reference.lon_rad[0],
-            reference.height_m[0],
-        );
-        let n = reference.time_s.len();
-        let step = (n / 3000).max(1);
-        let full = ne_of(reference, (0..n).step_by(step), origin);
-        let tracks: Vec<Vec<[f64; 2]>> = windows
-            .iter()
-            .map(|w| {
-                ne_of(
-                    reference,
-                    indices_in(&reference.time_s, w.start_s, w.end_s),
-                    origin,
-                )
-            })
-            .collect();
-        let solutions: Vec<(String, Vec<Vec<[f64; 2]>>)> = run
-            .cases
-            .iter()
-            .filter(|c| c.case != Case::Raw)
-            .filter_map(|c| {
-                let sol = c.forward_solution.as_ref()?;
-                Some((
-                    format!("{} forward", c.case.label()),
-                    windows
-                        .iter()
-                        .map(|w| {
-                            let r = indices_in(&sol.time_s, w.start_s, w.end_s);
-                            let st = (r.len() / 300).max(1);
-                            ne_of(sol, r.step_by(st), origin)
-                        })
-                        .collect(),
-                ))
-            })
-            .collect();
-        out.push((
-            "trajectory".into(),
-            "Trajectory (north-east, m from the start) with the GNSS outages (bold, numbered) \
-             and the forward filter's drift inside them (paper Fig. 2)"
-                .into(),
-            trajectory_figure(&full, &tracks, &solutions),
-        ));
-    }
+    out.extend(trajectory(run, &windows));
     let bars: Vec<(String, Vec<f64>)> = run
         .cases
         .iter()
@@ -195,6 +149,56 @@ pub fn figures(p: &Prepared, r: &ExperimentResult) -> Vec<(String, String, Figur
     out.into_iter()
         .map(|(name, caption, fig)| (name, caption, fit_to_width(fig, FIGURE_WIDTH)))
         .collect()
+}
+
+/// The trajectory figure: the reference track with the outage windows and each case's
+/// forward solution inside them (none without a reference).
+fn trajectory(run: &VehicleRun, windows: &[OutageWindow]) -> Option<(String, String, Figure)> {
+    let reference = run.reference.as_ref().filter(|r| !r.time_s.is_empty())?;
+    let origin = (
+        reference.lat_rad[0],
+        reference.lon_rad[0],
+        reference.height_m[0],
+    );
+    let n = reference.time_s.len();
+    let step = (n / 3000).max(1);
+    let full = ne_of(reference, (0..n).step_by(step), origin);
+    let tracks: Vec<Vec<[f64; 2]>> = windows
+        .iter()
+        .map(|w| {
+            ne_of(
+                reference,
+                indices_in(&reference.time_s, w.start_s, w.end_s),
+                origin,
+            )
+        })
+        .collect();
+    let solutions: Vec<(String, Vec<Vec<[f64; 2]>>)> = run
+        .cases
+        .iter()
+        .filter(|c| c.case != Case::Raw)
+        .filter_map(|c| {
+            let sol = c.forward_solution.as_ref()?;
+            Some((
+                format!("{} forward", c.case.label()),
+                windows
+                    .iter()
+                    .map(|w| {
+                        let r = indices_in(&sol.time_s, w.start_s, w.end_s);
+                        let st = (r.len() / 300).max(1);
+                        ne_of(sol, r.step_by(st), origin)
+                    })
+                    .collect(),
+            ))
+        })
+        .collect();
+    Some((
+        "trajectory".into(),
+        "Trajectory (north-east, m from the start) with the GNSS outages (bold, numbered) \
+         and the forward filter's drift inside them (paper Fig. 2)"
+            .into(),
+        trajectory_figure(&full, &tracks, &solutions),
+    ))
 }
 
 /// The HTML report: headline ratio, Table 1, Monte Carlo statistics, outage selection,

@@ -441,15 +441,80 @@ impl ExperimentScenario {
                 s.rate_hz
             )));
         }
-        let needs_sensor = |what: &str| -> Result<(), ExperimentError> {
-            if sensor.is_none() {
-                Err(self.invalid(format!(
-                    "{what} is simulated, so the scenario needs a [sensor] table (preset and rate_hz)"
-                )))
-            } else {
-                Ok(())
+        let has_sensor = sensor.is_some();
+        self.check_noise(has_sensor)?;
+        self.check_chamber(has_sensor)?;
+        let source = self.vehicle_source()?;
+        self.check_vehicle(source, has_sensor)?;
+        let spec: OutageSpec = self
+            .outages
+            .spec
+            .parse()
+            .map_err(|e| self.invalid(format!("outages.spec: {e}")))?;
+        if matches!(spec, OutageSpec::None) {
+            return Err(self.invalid(
+                "outages.spec = \"none\": the experiment measures drift in GNSS outages; give \
+                 e.g. \"auto:9x60\"",
+            ));
+        }
+        let f = &self.filter;
+        if !(f.bias_tau_s.is_finite() && f.bias_tau_s > 0.0) {
+            return Err(self.invalid(format!("filter.bias_tau_s = {}: must be > 0", f.bias_tau_s)));
+        }
+        if !(f.scale_sigma.is_finite() && f.scale_sigma >= 0.0 && f.scale_sigma < 0.5) {
+            return Err(self.invalid(format!(
+                "filter.scale_sigma = {}: a fraction in [0, 0.5)",
+                f.scale_sigma
+            )));
+        }
+        for (k, v) in [
+            (
+                "initial_gyro_bias_sigma_deg_s",
+                f.initial_gyro_bias_sigma_deg_s,
+            ),
+            (
+                "initial_accel_bias_sigma_m_s2",
+                f.initial_accel_bias_sigma_m_s2,
+            ),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v > 0.0)
+            {
+                return Err(self.invalid(format!("filter.{k} = {v}: must be > 0")));
             }
-        };
+        }
+        let mc = &self.monte_carlo;
+        if !(1..=10_000).contains(&mc.runs) {
+            return Err(self.invalid(format!("monte_carlo.runs = {}: 1 to 10 000", mc.runs)));
+        }
+        if !(mc.confidence > 0.5 && mc.confidence < 1.0) {
+            return Err(self.invalid(format!(
+                "monte_carlo.confidence = {}: between 0.5 and 1",
+                mc.confidence
+            )));
+        }
+        if self.noise.is_none() && source == VehicleSource::Simulated {
+            return Err(self.invalid(
+                "[noise] is missing: the filter's noise model comes from the Allan analysis \
+                 (give hours, file or model)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Error unless the scenario has a `[sensor]` table, which `what` needs to be simulated.
+    fn needs_sensor(&self, has_sensor: bool, what: &str) -> Result<(), ExperimentError> {
+        if !has_sensor {
+            Err(self.invalid(format!(
+                "{what} is simulated, so the scenario needs a [sensor] table (preset and rate_hz)"
+            )))
+        } else {
+            Ok(())
+        }
+    }
+
+    /// The `[noise]` table: one source of the noise model, usable.
+    fn check_noise(&self, has_sensor: bool) -> Result<(), ExperimentError> {
         if let Some(n) = &self.noise {
             let given = [n.hours.is_some(), n.file.is_some(), n.model.is_some()];
             if given.iter().filter(|g| **g).count() != 1 {
@@ -459,7 +524,7 @@ impl ExperimentScenario {
                 ));
             }
             if let Some(h) = n.hours {
-                needs_sensor("[noise]")?;
+                self.needs_sensor(has_sensor, "[noise]")?;
                 if !(h.is_finite() && (0.05..=100.0).contains(&h)) {
                     return Err(self.invalid(format!(
                         "noise.hours = {h}: a static log of 0.05 to 100 h is needed"
@@ -481,10 +546,16 @@ impl ExperimentScenario {
                 self.existing("noise.model", f)?;
             }
         }
+        Ok(())
+    }
+
+    /// The `[chamber]` table: a simulated protocol at the sensor's rate or a thermal model,
+    /// and a polynomial order of 1 to 5.
+    fn check_chamber(&self, has_sensor: bool) -> Result<(), ExperimentError> {
         if let Some(c) = &self.chamber {
             match (&c.protocol, &c.model) {
                 (Some(p), None) => {
-                    needs_sensor("[chamber]")?;
+                    self.needs_sensor(has_sensor, "[chamber]")?;
                     let rate = self.sensor.as_ref().map_or(0.0, |s| s.rate_hz);
                     if (p.sample_rate_hz - rate).abs() > 1e-9 * rate
                         && p.sample_rate_hz != ChamberConfig::default().sample_rate_hz
@@ -514,10 +585,20 @@ impl ExperimentScenario {
                 )));
             }
         }
-        let source = self.vehicle_source()?;
+        Ok(())
+    }
+
+    /// The `[vehicle]` table: a simulated run with GNSS at a rate not above the IMU's, or
+    /// recorded files that exist (one run, and a chamber only where the data carry a
+    /// temperature).
+    fn check_vehicle(
+        &self,
+        source: VehicleSource,
+        has_sensor: bool,
+    ) -> Result<(), ExperimentError> {
         match source {
             VehicleSource::Simulated => {
-                needs_sensor("[vehicle]")?;
+                self.needs_sensor(has_sensor, "[vehicle]")?;
                 if self.vehicle.trajectory.is_none() {
                     return Err(self.invalid("[vehicle.trajectory] is missing"));
                 }
@@ -585,59 +666,6 @@ impl ExperimentScenario {
                     _ => {}
                 }
             }
-        }
-        let spec: OutageSpec = self
-            .outages
-            .spec
-            .parse()
-            .map_err(|e| self.invalid(format!("outages.spec: {e}")))?;
-        if matches!(spec, OutageSpec::None) {
-            return Err(self.invalid(
-                "outages.spec = \"none\": the experiment measures drift in GNSS outages; give \
-                 e.g. \"auto:9x60\"",
-            ));
-        }
-        let f = &self.filter;
-        if !(f.bias_tau_s.is_finite() && f.bias_tau_s > 0.0) {
-            return Err(self.invalid(format!("filter.bias_tau_s = {}: must be > 0", f.bias_tau_s)));
-        }
-        if !(f.scale_sigma.is_finite() && f.scale_sigma >= 0.0 && f.scale_sigma < 0.5) {
-            return Err(self.invalid(format!(
-                "filter.scale_sigma = {}: a fraction in [0, 0.5)",
-                f.scale_sigma
-            )));
-        }
-        for (k, v) in [
-            (
-                "initial_gyro_bias_sigma_deg_s",
-                f.initial_gyro_bias_sigma_deg_s,
-            ),
-            (
-                "initial_accel_bias_sigma_m_s2",
-                f.initial_accel_bias_sigma_m_s2,
-            ),
-        ] {
-            if let Some(v) = v
-                && !(v.is_finite() && v > 0.0)
-            {
-                return Err(self.invalid(format!("filter.{k} = {v}: must be > 0")));
-            }
-        }
-        let mc = &self.monte_carlo;
-        if !(1..=10_000).contains(&mc.runs) {
-            return Err(self.invalid(format!("monte_carlo.runs = {}: 1 to 10 000", mc.runs)));
-        }
-        if !(mc.confidence > 0.5 && mc.confidence < 1.0) {
-            return Err(self.invalid(format!(
-                "monte_carlo.confidence = {}: between 0.5 and 1",
-                mc.confidence
-            )));
-        }
-        if self.noise.is_none() && source == VehicleSource::Simulated {
-            return Err(self.invalid(
-                "[noise] is missing: the filter's noise model comes from the Allan analysis \
-                 (give hours, file or model)",
-            ));
         }
         Ok(())
     }

@@ -281,72 +281,16 @@ fn read_impl<R: Read>(
     file: Option<&std::fs::File>,
 ) -> Result<ImuLog, LogError> {
     let at = || Location::input(source);
-    let io = |error| LogError::Io {
-        path: source.to_owned(),
-        error,
-    };
-    let truncated = |message: String| LogError::Truncated { at: at(), message };
-    let bad_header = |message: String| LogError::BadHeader { at: at(), message };
 
-    let mut pre = [0u8; 16];
-    let got = read_full(&mut r, &mut pre).map_err(io)?;
-    if got < 8 || pre[..8] != MAGIC[..] {
-        return Err(LogError::BadMagic {
-            at: at(),
-            found: excerpt(&pre[..got.min(8)]),
-        });
-    }
-    if got < 16 {
-        return Err(truncated(format!(
-            "file ends inside the 16-byte preamble (after {got} bytes)"
-        )));
-    }
-    let word = |i: usize| u32::from_le_bytes([pre[i], pre[i + 1], pre[i + 2], pre[i + 3]]);
-    let version = word(8);
-    if version != VERSION {
-        return Err(LogError::UnsupportedVersion {
-            at: at(),
-            version,
-            supported: VERSION,
-        });
-    }
-    let hlen = word(12);
-    if hlen > MAX_HEADER {
-        return Err(bad_header(format!(
-            "header length {hlen} bytes exceeds 1 MiB"
-        )));
-    }
-    let padded = (16 + hlen as usize).next_multiple_of(8) - 16;
-    let mut htext = vec![0u8; padded];
-    let got = read_full(&mut r, &mut htext).map_err(io)?;
-    if got < padded {
-        return Err(truncated(format!(
-            "file ends inside the {hlen}-byte header"
-        )));
-    }
-    let htext = htext.get(..hlen as usize).unwrap_or(&[]);
-    let htext = std::str::from_utf8(htext).map_err(|e| bad_header(format!("not UTF-8: {e}")))?;
-    let h: Header = toml::from_str(htext).map_err(|e| bad_header(e.message().to_owned()))?;
-    if h.encoding != "f64le" {
-        return Err(bad_header(format!(
-            "unsupported encoding {:?} (expected \"f64le\")",
-            h.encoding
-        )));
-    }
-    if h.channels.is_empty() {
-        return Err(bad_header("no channels".into()));
-    }
-    if !(h.tau0_s.is_finite() && h.tau0_s > 0.0) {
-        return Err(bad_header(format!(
-            "tau0_s must be positive and finite, got {}",
-            h.tau0_s
-        )));
-    }
+    let (h, padded) = read_header(&mut r, source)?;
     let ncols = h.channels.len() + usize::from(h.time_column);
     let data_bytes = (h.rows as u64)
         .checked_mul(ncols as u64)
         .and_then(|x| x.checked_mul(8))
-        .ok_or_else(|| bad_header(format!("row count {} too large", h.rows)))?;
+        .ok_or_else(|| LogError::BadHeader {
+            at: at(),
+            message: format!("row count {} too large", h.rows),
+        })?;
     let data_start = 16 + padded as u64;
     if let Some(size) = size {
         let found = size.saturating_sub(data_start);
@@ -360,22 +304,7 @@ fn read_impl<R: Read>(
             });
         }
     }
-    let mut prev_end = 0;
-    for s in &h.segments {
-        if !(s[0] < s[1] && s[1] <= h.rows && s[0] >= prev_end) {
-            return Err(bad_header(format!(
-                "segment {}..{} out of order or beyond {} rows",
-                s[0], s[1], h.rows
-            )));
-        }
-        prev_end = s[1];
-    }
-    if let Some(g) = h.gaps.iter().find(|g| g.index == 0 || g.index >= h.rows) {
-        return Err(bad_header(format!(
-            "gap at row {} outside 1..{}",
-            g.index, h.rows
-        )));
-    }
+    check_segments_and_gaps(&h, source)?;
 
     let names: Vec<&str> = h
         .time_column
@@ -406,50 +335,7 @@ fn read_impl<R: Read>(
     #[cfg(not(unix))]
     let _ = file;
     if columns.is_empty() {
-        let mut block = vec![0u8; IO_BLOCK];
-        for name in &names {
-            // Trust the row count for capacity only when the file size confirmed it.
-            let cap = if size.is_some() {
-                h.rows
-            } else {
-                h.rows.min(1 << 20)
-            };
-            let mut v: Vec<f64> = Vec::with_capacity(cap);
-            let mut finite = true;
-            while v.len() < h.rows {
-                let want = ((h.rows - v.len()) * 8).min(IO_BLOCK);
-                let buf = &mut block[..want];
-                let got = read_full(&mut r, buf).map_err(io)?;
-                if got < want {
-                    return Err(truncated(format!(
-                        "column {name} ends after {} of {} rows",
-                        v.len() + got / 8,
-                        h.rows
-                    )));
-                }
-                finite &= decode_into(buf, &mut v);
-            }
-            if !finite {
-                let row = v.iter().position(|x| !x.is_finite()).unwrap_or(0);
-                return Err(LogError::NonFiniteStored {
-                    at: at(),
-                    column: (*name).to_owned(),
-                    row,
-                });
-            }
-            columns.push(v);
-        }
-        let mut extra = [0u8; 1];
-        if read_full(&mut r, &mut extra).map_err(io)? > 0 {
-            let rest = std::io::copy(&mut r, &mut std::io::sink()).map_err(io)?;
-            return Err(LogError::CountMismatch {
-                at: at(),
-                rows: h.rows,
-                columns: ncols,
-                expected_bytes: data_bytes,
-                found_bytes: data_bytes + 1 + rest,
-            });
-        }
+        columns = read_columns(&mut r, &names, &h, size.is_some(), data_bytes, source)?;
     }
     let mut it = columns.into_iter();
     let time_s = if h.time_column { it.next() } else { None };
@@ -497,4 +383,162 @@ fn read_impl<R: Read>(
             .collect(),
         ..ImuLog::default()
     })
+}
+
+/// The preamble (magic, version, header length) and the TOML header, checked; returns the
+/// header and its length padded to 8 bytes.
+fn read_header<R: Read>(r: &mut R, source: &str) -> Result<(Header, usize), LogError> {
+    let at = || Location::input(source);
+    let io = |error| LogError::Io {
+        path: source.to_owned(),
+        error,
+    };
+    let truncated = |message: String| LogError::Truncated { at: at(), message };
+    let bad_header = |message: String| LogError::BadHeader { at: at(), message };
+    let mut pre = [0u8; 16];
+    let got = read_full(r, &mut pre).map_err(io)?;
+    if got < 8 || pre[..8] != MAGIC[..] {
+        return Err(LogError::BadMagic {
+            at: at(),
+            found: excerpt(&pre[..got.min(8)]),
+        });
+    }
+    if got < 16 {
+        return Err(truncated(format!(
+            "file ends inside the 16-byte preamble (after {got} bytes)"
+        )));
+    }
+    let word = |i: usize| u32::from_le_bytes([pre[i], pre[i + 1], pre[i + 2], pre[i + 3]]);
+    let version = word(8);
+    if version != VERSION {
+        return Err(LogError::UnsupportedVersion {
+            at: at(),
+            version,
+            supported: VERSION,
+        });
+    }
+    let hlen = word(12);
+    if hlen > MAX_HEADER {
+        return Err(bad_header(format!(
+            "header length {hlen} bytes exceeds 1 MiB"
+        )));
+    }
+    let padded = (16 + hlen as usize).next_multiple_of(8) - 16;
+    let mut htext = vec![0u8; padded];
+    let got = read_full(r, &mut htext).map_err(io)?;
+    if got < padded {
+        return Err(truncated(format!(
+            "file ends inside the {hlen}-byte header"
+        )));
+    }
+    let htext = htext.get(..hlen as usize).unwrap_or(&[]);
+    let htext = std::str::from_utf8(htext).map_err(|e| bad_header(format!("not UTF-8: {e}")))?;
+    let h: Header = toml::from_str(htext).map_err(|e| bad_header(e.message().to_owned()))?;
+    if h.encoding != "f64le" {
+        return Err(bad_header(format!(
+            "unsupported encoding {:?} (expected \"f64le\")",
+            h.encoding
+        )));
+    }
+    if h.channels.is_empty() {
+        return Err(bad_header("no channels".into()));
+    }
+    if !(h.tau0_s.is_finite() && h.tau0_s > 0.0) {
+        return Err(bad_header(format!(
+            "tau0_s must be positive and finite, got {}",
+            h.tau0_s
+        )));
+    }
+    Ok((h, padded))
+}
+
+/// Segments in order within the rows, gaps inside them.
+fn check_segments_and_gaps(h: &Header, source: &str) -> Result<(), LogError> {
+    let bad_header = |message: String| LogError::BadHeader {
+        at: Location::input(source),
+        message,
+    };
+    let mut prev_end = 0;
+    for s in &h.segments {
+        if !(s[0] < s[1] && s[1] <= h.rows && s[0] >= prev_end) {
+            return Err(bad_header(format!(
+                "segment {}..{} out of order or beyond {} rows",
+                s[0], s[1], h.rows
+            )));
+        }
+        prev_end = s[1];
+    }
+    if let Some(g) = h.gaps.iter().find(|g| g.index == 0 || g.index >= h.rows) {
+        return Err(bad_header(format!(
+            "gap at row {} outside 1..{}",
+            g.index, h.rows
+        )));
+    }
+    Ok(())
+}
+
+/// The columns read one after the other from a stream, each checked to be finite, and
+/// nothing after the last. `size_known`: the file size confirmed the row count (which then
+/// sizes the columns up front).
+fn read_columns<R: Read>(
+    r: &mut R,
+    names: &[&str],
+    h: &Header,
+    size_known: bool,
+    data_bytes: u64,
+    source: &str,
+) -> Result<Vec<Vec<f64>>, LogError> {
+    let at = || Location::input(source);
+    let io = |error| LogError::Io {
+        path: source.to_owned(),
+        error,
+    };
+    let truncated = |message: String| LogError::Truncated { at: at(), message };
+    let ncols = names.len();
+    let mut columns = Vec::with_capacity(ncols);
+    let mut block = vec![0u8; IO_BLOCK];
+    for name in names {
+        // Trust the row count for capacity only when the file size confirmed it.
+        let cap = if size_known {
+            h.rows
+        } else {
+            h.rows.min(1 << 20)
+        };
+        let mut v: Vec<f64> = Vec::with_capacity(cap);
+        let mut finite = true;
+        while v.len() < h.rows {
+            let want = ((h.rows - v.len()) * 8).min(IO_BLOCK);
+            let buf = &mut block[..want];
+            let got = read_full(r, buf).map_err(io)?;
+            if got < want {
+                return Err(truncated(format!(
+                    "column {name} ends after {} of {} rows",
+                    v.len() + got / 8,
+                    h.rows
+                )));
+            }
+            finite &= decode_into(buf, &mut v);
+        }
+        if !finite {
+            let row = v.iter().position(|x| !x.is_finite()).unwrap_or(0);
+            return Err(LogError::NonFiniteStored {
+                at: at(),
+                column: (*name).to_owned(),
+                row,
+            });
+        }
+        columns.push(v);
+    }
+    let mut extra = [0u8; 1];
+    if read_full(r, &mut extra).map_err(io)? > 0 {
+        let rest = std::io::copy(r, &mut std::io::sink()).map_err(io)?;
+        return Err(LogError::CountMismatch {
+            at: at(),
+            rows: h.rows,
+            columns: ncols,
+            expected_bytes: data_bytes,
+            found_bytes: data_bytes + 1 + rest,
+        });
+    }
+    Ok(columns)
 }

@@ -30,11 +30,14 @@
 
 use std::collections::BTreeMap;
 
-use super::autopilot::{
-    AutopilotFormat, AutopilotImu, AutopilotImuLogs, Column, Scalar, build_imu_log, u16_at, u64_at,
-};
-use super::error::{Location, LogError};
-use super::log::Quantity;
+use super::autopilot::{Scalar, u16_at, u64_at};
+use super::error::LogError;
+
+mod format;
+mod imu;
+
+use format::{flatten, info_value, key_value};
+pub use imu::imu_logs_from_ulog;
 
 /// The 7 magic bytes a ULog file starts with (then a version byte).
 pub const MAGIC: [u8; 7] = [0x55, 0x4c, 0x6f, 0x67, 0x01, 0x12, 0x35];
@@ -203,163 +206,6 @@ fn malformed(source: &str, offset: usize, message: String) -> LogError {
     }
 }
 
-/// One field of a format definition before flattening.
-struct FieldDef<'a> {
-    type_name: &'a str,
-    array: Option<usize>,
-    name: &'a str,
-}
-
-/// Splits `type[n] name` (the spec's field syntax).
-fn parse_field(text: &str) -> Option<FieldDef<'_>> {
-    let (ty, name) = text.trim().split_once(' ')?;
-    let name = name.trim();
-    if name.is_empty() || ty.is_empty() {
-        return None;
-    }
-    match ty.split_once('[') {
-        Some((base, rest)) => {
-            let n: usize = rest.strip_suffix(']')?.parse().ok()?;
-            Some(FieldDef {
-                type_name: base,
-                array: Some(n),
-                name,
-            })
-        }
-        None => Some(FieldDef {
-            type_name: ty,
-            array: None,
-            name,
-        }),
-    }
-}
-
-fn builtin(type_name: &str) -> Option<Scalar> {
-    Some(match type_name {
-        "int8_t" => Scalar::I8,
-        "uint8_t" => Scalar::U8,
-        "int16_t" => Scalar::I16,
-        "uint16_t" => Scalar::U16,
-        "int32_t" => Scalar::I32,
-        "uint32_t" => Scalar::U32,
-        "int64_t" => Scalar::I64,
-        "uint64_t" => Scalar::U64,
-        "float" => Scalar::F32,
-        "double" => Scalar::F64,
-        "bool" => Scalar::Bool,
-        "char" => Scalar::Char,
-        _ => return None,
-    })
-}
-
-/// Flattened layout of a format: (fields, row size, bytes of trailing padding).
-struct Layout {
-    fields: Vec<ULogField>,
-    size: usize,
-    trailing_padding: usize,
-}
-
-/// Flattens format `name` (nested types and arrays) into scalar fields.
-fn flatten(formats: &BTreeMap<String, String>, name: &str) -> Result<Layout, String> {
-    let mut fields = Vec::new();
-    let mut size = 0usize;
-    let trailing_padding = flatten_into(formats, name, "", 0, &mut size, &mut fields)?;
-    Ok(Layout {
-        fields,
-        size,
-        trailing_padding,
-    })
-}
-
-/// Appends the fields of format `name` at `*size` with prefix `prefix`; returns the size
-/// of the format's own trailing padding field (0 if its last field is not padding).
-fn flatten_into(
-    formats: &BTreeMap<String, String>,
-    name: &str,
-    prefix: &str,
-    depth: usize,
-    size: &mut usize,
-    out: &mut Vec<ULogField>,
-) -> Result<usize, String> {
-    if depth > MAX_NESTING {
-        return Err(format!(
-            "format nesting deeper than {MAX_NESTING} at {name:?} (recursive definition?)"
-        ));
-    }
-    let body = formats
-        .get(name)
-        .ok_or_else(|| format!("no format definition for type {name:?}"))?;
-    let mut trailing = 0;
-    for text in body.split(';').filter(|s| !s.trim().is_empty()) {
-        let f =
-            parse_field(text).ok_or_else(|| format!("bad field {text:?} in format {name:?}"))?;
-        let count = f.array.unwrap_or(1);
-        let start = *size;
-        let padding = f.name.starts_with("_padding");
-        for k in 0..count {
-            let field_name = match f.array {
-                Some(_) => format!("{prefix}{}[{k}]", f.name),
-                None => format!("{prefix}{}", f.name),
-            };
-            match builtin(f.type_name) {
-                Some(s) => {
-                    if !padding {
-                        out.push(ULogField {
-                            name: field_name,
-                            scalar: s,
-                            offset: *size,
-                        });
-                    }
-                    *size += s.size();
-                }
-                None => {
-                    flatten_into(
-                        formats,
-                        f.type_name,
-                        &format!("{field_name}."),
-                        depth + 1,
-                        size,
-                        out,
-                    )?;
-                }
-            }
-            if *size > MAX_ROW || out.len() > MAX_ROW {
-                return Err(format!(
-                    "format {name:?} is larger than {MAX_ROW} bytes, the most a message holds"
-                ));
-            }
-        }
-        trailing = if padding { *size - start } else { 0 };
-    }
-    Ok(trailing)
-}
-
-/// Decodes the value of an `I`/`M`/`P` message given its `type key` string.
-fn info_value(type_name: &str, value: &[u8]) -> InfoValue {
-    let (base, array) = match type_name.split_once('[') {
-        Some((b, _)) => (b, true),
-        None => (type_name, false),
-    };
-    if base == "char" {
-        return InfoValue::Text(String::from_utf8_lossy(value).into_owned());
-    }
-    match builtin(base) {
-        Some(s) if !array && value.len() == s.size() => match s.read_f64(value) {
-            Some(v) => InfoValue::Number(v),
-            None => InfoValue::Bytes(value.to_vec()),
-        },
-        _ => InfoValue::Bytes(value.to_vec()),
-    }
-}
-
-/// Splits an `I`-style payload (`u8` key length, key `type name`, value).
-fn key_value(p: &[u8]) -> Option<(&str, &str, &[u8])> {
-    let n = usize::from(*p.first()?);
-    let key = std::str::from_utf8(p.get(1..1 + n)?).ok()?;
-    let (ty, name) = key.split_once(' ')?;
-    Some((ty, name, p.get(1 + n..)?))
-}
-
 /// Parses a whole ULog file held in memory.
 pub fn parse_ulog(bytes: &[u8], source: &str) -> Result<ULog, LogError> {
     if bytes.len() < 16 || !bytes.starts_with(&MAGIC) {
@@ -377,75 +223,90 @@ pub fn parse_ulog(bytes: &[u8], source: &str) -> Result<ULog, LogError> {
         };
         return Err(malformed(source, 0, what));
     }
-    let mut log = ULog {
-        version: bytes[7],
-        start_time_us: u64_at(bytes, 8).unwrap_or(0),
-        ..ULog::default()
+    let mut r = Reader {
+        bytes,
+        source,
+        log: ULog {
+            version: bytes[7],
+            start_time_us: u64_at(bytes, 8).unwrap_or(0),
+            ..ULog::default()
+        },
+        subscribed: BTreeMap::new(),
+        layouts: Vec::new(),
+        unknown_types: BTreeMap::new(),
+        unsubscribed_rows: 0,
+        flattened: 0,
+        appended: Vec::new(),
     };
-    // msg_id → index into log.topics.
-    let mut subscribed: BTreeMap<u16, usize> = BTreeMap::new();
-    let mut layouts: Vec<(usize, usize)> = Vec::new(); // per topic: (row size, min row size)
-    let mut unknown_types: BTreeMap<u8, usize> = BTreeMap::new();
-    let mut unsubscribed_rows = 0usize;
-    let mut flattened = 0usize;
     let mut pos = 16usize;
     let mut first = true;
-    let mut appended: Vec<usize> = Vec::new();
     while pos < bytes.len() {
         let start = pos;
         let (Some(size), Some(&kind)) = (u16_at(bytes, pos), bytes.get(pos + 2)) else {
-            log.truncated_at_byte = Some(start as u64);
+            r.log.truncated_at_byte = Some(start as u64);
             break;
         };
         let end = pos + 3 + usize::from(size);
         // A block of appended data starts inside this message: the message was cut when
         // the data was appended; resume at the block.
-        if let Some(&next) = appended.iter().find(|&&a| a > start && a < end) {
-            log.notes.push(format!(
+        if let Some(&next) = r.appended.iter().find(|&&a| a > start && a < end) {
+            r.log.notes.push(format!(
                 "message at byte {start} cut by appended data at byte {next}; skipped"
             ));
             pos = next;
             continue;
         }
         let Some(p) = bytes.get(pos + 3..end) else {
-            log.truncated_at_byte = Some(start as u64);
+            r.log.truncated_at_byte = Some(start as u64);
             break;
         };
-        let bad = |m: String| malformed(source, start, m);
+        r.message(kind, start, end, p, first)?;
+        first = false;
+        pos = end;
+    }
+    Ok(r.finish())
+}
+
+/// The state of [`parse_ulog`] between messages.
+struct Reader<'a> {
+    bytes: &'a [u8],
+    source: &'a str,
+    log: ULog,
+    /// msg_id → index into `log.topics`.
+    subscribed: BTreeMap<u16, usize>,
+    /// Per topic: (row size, min row size).
+    layouts: Vec<(usize, usize)>,
+    unknown_types: BTreeMap<u8, usize>,
+    unsubscribed_rows: usize,
+    /// Fields of all subscribed topics so far.
+    flattened: usize,
+    /// Byte offsets where appended data blocks start.
+    appended: Vec<usize>,
+}
+
+impl Reader<'_> {
+    fn bad(&self, start: usize, m: String) -> LogError {
+        malformed(self.source, start, m)
+    }
+
+    /// One message of type `kind` with payload `p` (bytes `start..end` of the file).
+    fn message(
+        &mut self,
+        kind: u8,
+        start: usize,
+        end: usize,
+        p: &[u8],
+        first: bool,
+    ) -> Result<(), LogError> {
+        let bad = |m: String| malformed(self.source, start, m);
         match kind {
             b'B' => {
                 if !first {
-                    log.notes.push(format!(
+                    self.log.notes.push(format!(
                         "flag bits message at byte {start} not first; ignored"
                     ));
                 } else {
-                    if p.len() < 40 {
-                        return Err(bad(format!(
-                            "flag bits message of {} bytes, expected at least 40",
-                            p.len()
-                        )));
-                    }
-                    let incompat = &p[8..16];
-                    if incompat[0] & !1 != 0 || incompat[1..].iter().any(|&b| b != 0) {
-                        return Err(bad(format!(
-                            "unknown incompatible flags {incompat:02x?}: this file needs a newer ULog reader"
-                        )));
-                    }
-                    if incompat[0] & 1 != 0 {
-                        for k in 0..3 {
-                            let off = u64_at(p, 16 + 8 * k).unwrap_or(0);
-                            if off != 0 {
-                                log.appended_offsets.push(off);
-                                if let Ok(o) = usize::try_from(off)
-                                    && o > end
-                                    && o <= bytes.len()
-                                {
-                                    appended.push(o);
-                                }
-                            }
-                        }
-                        appended.sort_unstable();
-                    }
+                    self.flag_bits(start, end, p)?;
                 }
             }
             b'F' => {
@@ -454,108 +315,16 @@ pub fn parse_ulog(bytes: &[u8], source: &str) -> Result<ULog, LogError> {
                 let (name, body) = text
                     .split_once(':')
                     .ok_or_else(|| bad(format!("format definition without ':': {text:?}")))?;
-                log.formats.insert(name.to_owned(), body.to_owned());
+                self.log.formats.insert(name.to_owned(), body.to_owned());
             }
-            b'I' | b'M' | b'P' => {
-                let p = if kind == b'M' {
-                    p.get(1..).unwrap_or(&[])
-                } else {
-                    p
-                };
-                let (ty, name, value) = key_value(p).ok_or_else(|| {
-                    bad(format!("malformed '{}' key/value message", kind as char))
-                })?;
-                let v = info_value(ty, value);
-                if kind == b'P' {
-                    match v {
-                        InfoValue::Number(x) => {
-                            log.parameters.insert(name.to_owned(), x);
-                        }
-                        _ => log.notes.push(format!(
-                            "parameter {name:?} of type {ty:?} at byte {start} skipped"
-                        )),
-                    }
-                } else {
-                    let e = log.info.entry(name.to_owned()).or_default();
-                    if kind == b'I' {
-                        e.clear();
-                    }
-                    e.push(v);
-                }
-            }
-            b'A' => {
-                let (Some(&multi_id), Some(msg_id), Some(name)) =
-                    (p.first(), u16_at(p, 1), p.get(3..))
-                else {
-                    return Err(bad("subscription message shorter than 3 bytes".into()));
-                };
-                let name =
-                    std::str::from_utf8(name).map_err(|_| bad("topic name is not UTF-8".into()))?;
-                let idx = match log
-                    .topics
-                    .iter()
-                    .position(|t| t.name == name && t.multi_id == multi_id)
-                {
-                    Some(i) => i,
-                    None => {
-                        let layout = flatten(&log.formats, name)
-                            .map_err(|m| bad(format!("topic {name:?}: {m}")))?;
-                        flattened += layout.fields.len();
-                        if flattened > MAX_FIELDS {
-                            return Err(bad(format!(
-                                "more than {MAX_FIELDS} fields in all subscribed topics"
-                            )));
-                        }
-                        log.topics.push(Topic {
-                            name: name.to_owned(),
-                            multi_id,
-                            fields: layout.fields,
-                            row_size: layout.size,
-                            data: Vec::new(),
-                            row_offsets: Vec::new(),
-                        });
-                        layouts.push((layout.size, layout.size - layout.trailing_padding));
-                        log.topics.len() - 1
-                    }
-                };
-                subscribed.insert(msg_id, idx);
-            }
+            b'I' | b'M' | b'P' => self.key_value(kind, start, p)?,
+            b'A' => self.subscribe(start, p)?,
             b'R' => {
                 if let Some(id) = u16_at(p, 0) {
-                    subscribed.remove(&id);
+                    self.subscribed.remove(&id);
                 }
             }
-            b'D' => {
-                let Some(id) = u16_at(p, 0) else {
-                    return Err(bad("data message shorter than its 2-byte id".into()));
-                };
-                let row = &p[2..];
-                match subscribed.get(&id) {
-                    None => unsubscribed_rows += 1,
-                    Some(&i) => {
-                        let (full, min) = layouts.get(i).copied().unwrap_or((0, 0));
-                        let Some(t) = log.topics.get_mut(i) else {
-                            return Err(bad(format!("internal: no topic for msg_id {id}")));
-                        };
-                        if row.len() > full || row.len() < min {
-                            return Err(bad(format!(
-                                "data row of {} bytes for topic {}[{}], whose format has {full} bytes{}",
-                                row.len(),
-                                t.name,
-                                t.multi_id,
-                                if min < full {
-                                    format!(" ({min} without trailing padding)")
-                                } else {
-                                    String::new()
-                                }
-                            )));
-                        }
-                        t.data.extend_from_slice(row);
-                        t.data.resize(t.data.len() + full - row.len(), 0);
-                        t.row_offsets.push(start as u64);
-                    }
-                }
-            }
+            b'D' => self.data(start, p)?,
             b'L' | b'C' => {
                 let tagged = kind == b'C';
                 let head = if tagged { 11 } else { 9 };
@@ -564,7 +333,7 @@ pub fn parse_ulog(bytes: &[u8], source: &str) -> Result<ULog, LogError> {
                 else {
                     return Err(bad("log string message too short".into()));
                 };
-                log.log_messages.push(ULogString {
+                self.log.log_messages.push(ULogString {
                     level,
                     tag: if tagged { u16_at(p, 1) } else { None },
                     timestamp_us: ts,
@@ -573,267 +342,186 @@ pub fn parse_ulog(bytes: &[u8], source: &str) -> Result<ULog, LogError> {
             }
             b'O' => {
                 let duration_ms = u16_at(p, 0).unwrap_or(0);
-                log.dropouts.push(Dropout {
+                self.log.dropouts.push(Dropout {
                     byte_offset: start as u64,
                     duration_ms,
                 });
             }
             b'S' | b'Q' => {}
-            other => *unknown_types.entry(other).or_default() += 1,
+            other => *self.unknown_types.entry(other).or_default() += 1,
         }
-        first = false;
-        pos = end;
+        Ok(())
     }
-    if unsubscribed_rows > 0 {
-        log.notes.push(format!(
-            "{unsubscribed_rows} data message(s) for unsubscribed ids skipped"
-        ));
-    }
-    for (k, n) in unknown_types {
-        log.notes
-            .push(format!("{n} message(s) of unknown type 0x{k:02x} skipped"));
-    }
-    if !log.dropouts.is_empty() {
-        let total: u64 = log.dropouts.iter().map(|d| u64::from(d.duration_ms)).sum();
-        log.notes.push(format!(
-            "{} logger drop-out(s), {total} ms in all",
-            log.dropouts.len()
-        ));
-    }
-    Ok(log)
-}
 
-/// One [`crate::io::ImuLog`] per IMU instance from `sensor_gyro` (x, y, z in rad/s,
-/// `temperature` in °C) and `sensor_accel` (x, y, z in m/s², `temperature`).
-///
-/// **Alignment.** The two topics are separate uORB messages with their own time stamps
-/// (tens of µs apart for one IMU chip). Gyro instance *k* is paired with accel instance *k*
-/// (the same `multi_id`; a note is added when their `device_id`s differ) and each gyro row
-/// takes the accel row **nearest in time** if it lies within half the larger of the two
-/// median sample intervals; gyro rows without such a partner are dropped (counted in the
-/// notes). Nearest-neighbour, not interpolation: no sample is invented, and the pairing
-/// error (≤ half an interval) is irrelevant to bias-versus-temperature fits. The log's time
-/// base is the gyro's `timestamp`. Channels: `gyro_x/y/z`, `acc_x/y/z`, `temperature`
-/// (the gyro's), plus `acc_temperature` (quantity `Other`, unit degC) only when the accel
-/// topic's temperature differs from the gyro's on some row. An instance with only one of
-/// the two topics gives a log with that triad alone.
-pub fn imu_logs_from_ulog(bytes: &[u8], source: &str) -> Result<AutopilotImuLogs, LogError> {
-    let ulog = parse_ulog(bytes, source)?;
-    let mut found: Vec<(String, usize)> = ulog
-        .topics
-        .iter()
-        .map(|t| (format!("{}[{}]", t.name, t.multi_id), t.len()))
-        .collect();
-    found.sort();
-    let mut notes = ulog.notes.clone();
-    let mut ids: Vec<u8> = ulog
-        .topics
-        .iter()
-        .filter(|t| (t.name == "sensor_gyro" || t.name == "sensor_accel") && !t.is_empty())
-        .map(|t| t.multi_id)
-        .collect();
-    ids.sort_unstable();
-    ids.dedup();
-    if ids.is_empty() {
-        return Err(LogError::Malformed {
-            at: Location::input(source),
-            format: FORMAT,
-            message: format!(
-                "no sensor_gyro or sensor_accel data (topics: {})",
-                super::autopilot::list_counts(&found)
-            ),
-        });
-    }
-    let mut imus = Vec::new();
-    for id in ids {
-        let gyro = ulog.topic("sensor_gyro", id).filter(|t| !t.is_empty());
-        let accel = ulog.topic("sensor_accel", id).filter(|t| !t.is_empty());
-        let log = instance_log(source, id, gyro, accel, &mut notes)?;
-        imus.push(AutopilotImu { instance: id, log });
-    }
-    Ok(AutopilotImuLogs {
-        format: AutopilotFormat::ULog,
-        imus,
-        truncated_at_byte: ulog.truncated_at_byte,
-        found,
-        notes,
-    })
-}
-
-/// A sensor topic's columns: (time µs, byte offsets, x, y, z, temperature?).
-type Triad = (Vec<u64>, Vec<u64>, [Vec<f64>; 3], Option<Vec<f64>>);
-
-fn triad(source: &str, t: &Topic) -> Result<Triad, LogError> {
-    let missing = |what: &str| LogError::AtByte {
-        path: source.to_owned(),
-        byte_offset: t.row_byte_offset(0).unwrap_or(0),
-        format: FORMAT,
-        message: format!(
-            "topic {}[{}] has no {what} field (fields: {})",
-            t.name,
-            t.multi_id,
-            t.field_names().collect::<Vec<_>>().join(", ")
-        ),
-    };
-    let time = t
-        .timestamps_us()
-        .ok_or_else(|| missing("uint64_t timestamp"))?;
-    let col = |n: &str| t.column(n).ok_or_else(|| missing(n));
-    Ok((
-        time,
-        t.row_offsets.clone(),
-        [col("x")?, col("y")?, col("z")?],
-        t.column("temperature"),
-    ))
-}
-
-fn median_dt_us(t: &[u64]) -> u64 {
-    let mut d: Vec<u64> = t.windows(2).map(|w| w[1].saturating_sub(w[0])).collect();
-    d.sort_unstable();
-    d.get(d.len() / 2).copied().unwrap_or(0)
-}
-
-fn instance_log(
-    source: &str,
-    id: u8,
-    gyro: Option<&Topic>,
-    accel: Option<&Topic>,
-    notes: &mut Vec<String>,
-) -> Result<crate::io::ImuLog, LogError> {
-    let temp_col = |values| Column {
-        name: "temperature",
-        quantity: Quantity::Temperature,
-        source_unit: "degC",
-        values,
-    };
-    let triad_cols =
-        |names: [&'static str; 3], q: Quantity, unit: &'static str, v: [Vec<f64>; 3]| {
-            let [x, y, z] = v;
-            [x, y, z]
-                .into_iter()
-                .zip(names)
-                .map(|(values, name)| Column {
-                    name,
-                    quantity: q,
-                    source_unit: unit,
-                    values,
-                })
-                .collect::<Vec<_>>()
-        };
-    const GYRO: [&str; 3] = ["gyro_x", "gyro_y", "gyro_z"];
-    const ACC: [&str; 3] = ["acc_x", "acc_y", "acc_z"];
-    match (gyro, accel) {
-        (None, None) => Err(LogError::Malformed {
-            at: Location::input(source),
-            format: FORMAT,
-            message: format!("IMU instance {id} has no data"),
-        }),
-        (Some(only), None) | (None, Some(only)) => {
-            let is_gyro = gyro.is_some();
-            notes.push(format!(
-                "instance {id}: {} only (no {} topic)",
-                only.name,
-                if is_gyro {
-                    "sensor_accel"
-                } else {
-                    "sensor_gyro"
-                }
+    /// The flag bits message: unknown incompatible flags refused, appended-data offsets kept.
+    fn flag_bits(&mut self, start: usize, end: usize, p: &[u8]) -> Result<(), LogError> {
+        if p.len() < 40 {
+            return Err(self.bad(
+                start,
+                format!(
+                    "flag bits message of {} bytes, expected at least 40",
+                    p.len()
+                ),
             ));
-            let (time, offsets, xyz, temp) = triad(source, only)?;
-            let mut cols = if is_gyro {
-                triad_cols(GYRO, Quantity::AngularRate, "rad/s", xyz)
-            } else {
-                triad_cols(ACC, Quantity::SpecificForce, "m/s^2", xyz)
-            };
-            cols.extend(temp.map(temp_col));
-            build_imu_log(source, FORMAT, &time, &offsets, cols)
         }
-        (Some(g), Some(a)) => {
-            let (gt, goff, gxyz, gtemp) = triad(source, g)?;
-            let (at, _, axyz, atemp) = triad(source, a)?;
-            if let (Some(gd), Some(ad)) = (g.column("device_id"), a.column("device_id"))
-                && gd.first() != ad.first()
-            {
-                notes.push(format!(
-                    "instance {id}: sensor_gyro device_id {:?} differs from sensor_accel's {:?}; paired by instance number",
-                    gd.first(),
-                    ad.first()
-                ));
-            }
-            let tol = median_dt_us(&gt).max(median_dt_us(&at)) / 2;
-            // Nearest accel row for each gyro row (both time series are walked once; a
-            // non-monotonic series is caught by build_imu_log for the gyro, and only
-            // worsens pairing for the accel).
-            let mut pairs: Vec<(usize, usize)> = Vec::with_capacity(gt.len());
-            let mut j = 0usize;
-            for (i, &t) in gt.iter().enumerate() {
-                while j + 1 < at.len() && at[j + 1] <= t {
-                    j += 1;
-                }
-                let best = [j, j + 1]
-                    .into_iter()
-                    .filter(|&k| k < at.len())
-                    .min_by_key(|&k| at[k].abs_diff(t));
-                if let Some(k) = best
-                    && at[k].abs_diff(t) <= tol
-                {
-                    pairs.push((i, k));
-                }
-            }
-            if pairs.len() < gt.len() {
-                notes.push(format!(
-                    "instance {id}: {} of {} gyro rows had no accel row within {tol} µs and were dropped",
-                    gt.len() - pairs.len(),
-                    gt.len()
-                ));
-            }
-            let pick = |v: &[f64], gyro_side: bool| -> Vec<f64> {
-                pairs
-                    .iter()
-                    .map(|&(i, k)| {
-                        v.get(if gyro_side { i } else { k })
-                            .copied()
-                            .unwrap_or(f64::NAN)
-                    })
-                    .collect()
-            };
-            let time: Vec<u64> = pairs.iter().map(|&(i, _)| gt[i]).collect();
-            let offsets: Vec<u64> = pairs
-                .iter()
-                .map(|&(i, _)| goff.get(i).copied().unwrap_or(0))
-                .collect();
-            let mut cols = triad_cols(
-                GYRO,
-                Quantity::AngularRate,
-                "rad/s",
-                gxyz.each_ref().map(|v| pick(v, true)),
-            );
-            cols.extend(triad_cols(
-                ACC,
-                Quantity::SpecificForce,
-                "m/s^2",
-                axyz.each_ref().map(|v| pick(v, false)),
+        let incompat = &p[8..16];
+        if incompat[0] & !1 != 0 || incompat[1..].iter().any(|&b| b != 0) {
+            return Err(self.bad(
+                start,
+                format!(
+                    "unknown incompatible flags {incompat:02x?}: this file needs a newer ULog reader"
+                ),
             ));
-            let gtemp = gtemp.map(|v| pick(&v, true));
-            let atemp = atemp.map(|v| pick(&v, false));
-            let temp_differs = matches!((&gtemp, &atemp), (Some(g), Some(a)) if g != a);
-            match (gtemp, atemp) {
-                (Some(g), Some(a)) => {
-                    cols.push(temp_col(g));
-                    if temp_differs {
-                        cols.push(Column {
-                            name: "acc_temperature",
-                            quantity: Quantity::Other,
-                            source_unit: "degC",
-                            values: a,
-                        });
+        }
+        if incompat[0] & 1 != 0 {
+            for k in 0..3 {
+                let off = u64_at(p, 16 + 8 * k).unwrap_or(0);
+                if off != 0 {
+                    self.log.appended_offsets.push(off);
+                    if let Ok(o) = usize::try_from(off)
+                        && o > end
+                        && o <= self.bytes.len()
+                    {
+                        self.appended.push(o);
                     }
                 }
-                (Some(t), None) | (None, Some(t)) => cols.push(temp_col(t)),
-                (None, None) => {}
             }
-            build_imu_log(source, FORMAT, &time, &offsets, cols)
+            self.appended.sort_unstable();
         }
+        Ok(())
+    }
+
+    /// An information (`I`), multi-information (`M`) or parameter (`P`) message.
+    fn key_value(&mut self, kind: u8, start: usize, p: &[u8]) -> Result<(), LogError> {
+        let p = if kind == b'M' {
+            p.get(1..).unwrap_or(&[])
+        } else {
+            p
+        };
+        let (ty, name, value) = key_value(p).ok_or_else(|| {
+            self.bad(
+                start,
+                format!("malformed '{}' key/value message", kind as char),
+            )
+        })?;
+        let v = info_value(ty, value);
+        if kind == b'P' {
+            match v {
+                InfoValue::Number(x) => {
+                    self.log.parameters.insert(name.to_owned(), x);
+                }
+                _ => self.log.notes.push(format!(
+                    "parameter {name:?} of type {ty:?} at byte {start} skipped"
+                )),
+            }
+        } else {
+            let e = self.log.info.entry(name.to_owned()).or_default();
+            if kind == b'I' {
+                e.clear();
+            }
+            e.push(v);
+        }
+        Ok(())
+    }
+
+    /// A subscription: the topic instance's format flattened (once) and its msg_id bound.
+    fn subscribe(&mut self, start: usize, p: &[u8]) -> Result<(), LogError> {
+        let bad = |m: String| malformed(self.source, start, m);
+        let (Some(&multi_id), Some(msg_id), Some(name)) = (p.first(), u16_at(p, 1), p.get(3..))
+        else {
+            return Err(bad("subscription message shorter than 3 bytes".into()));
+        };
+        let name = std::str::from_utf8(name).map_err(|_| bad("topic name is not UTF-8".into()))?;
+        let idx = match self
+            .log
+            .topics
+            .iter()
+            .position(|t| t.name == name && t.multi_id == multi_id)
+        {
+            Some(i) => i,
+            None => {
+                let layout = flatten(&self.log.formats, name)
+                    .map_err(|m| bad(format!("topic {name:?}: {m}")))?;
+                self.flattened += layout.fields.len();
+                if self.flattened > MAX_FIELDS {
+                    return Err(bad(format!(
+                        "more than {MAX_FIELDS} fields in all subscribed topics"
+                    )));
+                }
+                self.log.topics.push(Topic {
+                    name: name.to_owned(),
+                    multi_id,
+                    fields: layout.fields,
+                    row_size: layout.size,
+                    data: Vec::new(),
+                    row_offsets: Vec::new(),
+                });
+                self.layouts
+                    .push((layout.size, layout.size - layout.trailing_padding));
+                self.log.topics.len() - 1
+            }
+        };
+        self.subscribed.insert(msg_id, idx);
+        Ok(())
+    }
+
+    /// A data row: appended to its topic (padded to the full row size), after checking
+    /// its length against the format.
+    fn data(&mut self, start: usize, p: &[u8]) -> Result<(), LogError> {
+        let bad = |m: String| malformed(self.source, start, m);
+        let Some(id) = u16_at(p, 0) else {
+            return Err(bad("data message shorter than its 2-byte id".into()));
+        };
+        let row = &p[2..];
+        match self.subscribed.get(&id) {
+            None => self.unsubscribed_rows += 1,
+            Some(&i) => {
+                let (full, min) = self.layouts.get(i).copied().unwrap_or((0, 0));
+                let Some(t) = self.log.topics.get_mut(i) else {
+                    return Err(bad(format!("internal: no topic for msg_id {id}")));
+                };
+                if row.len() > full || row.len() < min {
+                    return Err(bad(format!(
+                        "data row of {} bytes for topic {}[{}], whose format has {full} bytes{}",
+                        row.len(),
+                        t.name,
+                        t.multi_id,
+                        if min < full {
+                            format!(" ({min} without trailing padding)")
+                        } else {
+                            String::new()
+                        }
+                    )));
+                }
+                t.data.extend_from_slice(row);
+                t.data.resize(t.data.len() + full - row.len(), 0);
+                t.row_offsets.push(start as u64);
+            }
+        }
+        Ok(())
+    }
+
+    /// The log with notes on what was skipped and on logger drop-outs.
+    fn finish(mut self) -> ULog {
+        let log = &mut self.log;
+        if self.unsubscribed_rows > 0 {
+            log.notes.push(format!(
+                "{} data message(s) for unsubscribed ids skipped",
+                self.unsubscribed_rows
+            ));
+        }
+        for (k, n) in &self.unknown_types {
+            log.notes
+                .push(format!("{n} message(s) of unknown type 0x{k:02x} skipped"));
+        }
+        if !log.dropouts.is_empty() {
+            let total: u64 = log.dropouts.iter().map(|d| u64::from(d.duration_ms)).sum();
+            log.notes.push(format!(
+                "{} logger drop-out(s), {total} ms in all",
+                log.dropouts.len()
+            ));
+        }
+        self.log
     }
 }
 

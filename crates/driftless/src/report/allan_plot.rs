@@ -75,34 +75,7 @@ pub fn figure(
         // y range: the data with its bars, extended down to the flicker floor 0.664·B,
         // which lies below the curve's minimum (white noise and rate random walk still add
         // there) and would otherwise be clipped away.
-        let pos = |v: &f64| v.is_finite() && *v > 0.0;
-        let data_min = dev
-            .iter()
-            .chain(&lo)
-            .copied()
-            .filter(pos)
-            .fold(f64::INFINITY, f64::min);
-        let data_max = dev
-            .iter()
-            .chain(&hi)
-            .copied()
-            .filter(pos)
-            .fold(0.0, f64::max);
-        let floor = fits
-            .get(i)
-            .copied()
-            .flatten()
-            .and_then(|f| f.bias_instability)
-            .filter(|t| t.lo > 0.0)
-            .map(|t| (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt() * t.value * k);
-        let y_range = (data_min.is_finite() && data_max > 0.0).then(|| {
-            let bottom = floor.filter(pos).map_or(data_min, |f| f.min(data_min));
-            (bottom / 1.3, data_max * 1.3)
-        });
-        let (tmin, tmax) = (
-            tau.first().copied().unwrap_or(1.0),
-            tau.last().copied().unwrap_or(10.0),
-        );
+        let y_range = y_range(&dev, &lo, &hi, fits.get(i).copied().flatten(), k);
         let mut plot = LogLogPlot::new(
             format!("{} — {}", r.name, r.estimator.name().to_uppercase()),
             "averaging time τ (s)",
@@ -118,103 +91,7 @@ pub fn figure(
             .with_color(color),
         );
         if let Some(Some(f)) = fits.get(i) {
-            let model = Line::new(
-                "fitted model",
-                tau.clone(),
-                tau.iter().map(|&t| f.model_avar(t).sqrt() * k).collect(),
-            )
-            .with_color(Color::rgb(0x20, 0x20, 0x20));
-            plot = plot.with_line(model);
-            let grey = Color::rgb(0x70, 0x70, 0x70);
-            // Draw only terms whose interval excludes zero; the others are listed in the
-            // noise table with their intervals.
-            let significant = |t: &crate::allan::fit::Term| t.lo > 0.0;
-            let mut asym = |name: &str, term: char, v: f64, coeff: f64, exp: f64, at: f64| {
-                let l = Line::power_law(name, coeff * k, exp, tmin, tmax, 32)
-                    .dashed()
-                    .with_color(grey)
-                    .with_label(term_label(term, q, v))
-                    .with_label_at(at);
-                plot.lines.push(l);
-            };
-            let geo = |a: f64, b: f64| (a * b).sqrt();
-            if let Some(t) = f.quantization.filter(significant) {
-                asym(
-                    "Q asymptote",
-                    'Q',
-                    t.value,
-                    3f64.sqrt() * t.value,
-                    -1.0,
-                    tmin * 2.0,
-                );
-            }
-            if let Some(t) = f.white.filter(significant) {
-                asym(
-                    "N asymptote",
-                    'N',
-                    t.value,
-                    t.value,
-                    -0.5,
-                    geo(tmin, geo(tmin, tmax)),
-                );
-            }
-            if let Some(t) = f.bias_instability.filter(significant) {
-                let c = (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt();
-                asym(
-                    "B asymptote",
-                    'B',
-                    t.value,
-                    c * t.value,
-                    0.0,
-                    geo(tmin, tmax),
-                );
-            }
-            if let Some(t) = f.rate_random_walk.filter(significant) {
-                asym(
-                    "K asymptote",
-                    'K',
-                    t.value,
-                    t.value / 3f64.sqrt(),
-                    0.5,
-                    geo(geo(tmin, tmax), tmax),
-                );
-            }
-            if let Some(t) = f.rate_ramp.filter(significant) {
-                asym(
-                    "R asymptote",
-                    'R',
-                    t.value,
-                    t.value / 2f64.sqrt(),
-                    1.0,
-                    tmax / 2.0,
-                );
-            }
-            if let Some(gm) = f.gauss_markov.filter(|g| significant(&g.sigma)) {
-                let (s, tc) = (gm.sigma.value, gm.tau_c_s.value);
-                let y: Vec<f64> = tau
-                    .iter()
-                    .map(|&t| gauss_markov_avar(s, tc, t).sqrt() * k)
-                    .collect();
-                plot.lines.push(
-                    Line::new("Gauss-Markov term", tau.clone(), y)
-                        .dashed()
-                        .with_color(grey)
-                        .with_label(format!(
-                            "GM σ = {}, T = {} s",
-                            format_sig(s * k),
-                            format_sig(tc)
-                        )),
-                );
-            }
-            // Mark the curve's minimum (where bias instability is read classically).
-            if let Some((j, _)) = dev
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| v.is_finite() && **v > 0.0)
-                .min_by(|a, b| a.1.total_cmp(b.1))
-            {
-                plot = plot.with_annotation(Annotation::new("minimum", tau[j], dev[j]));
-            }
+            plot = with_model(plot, f, q, k, &tau, &dev);
         }
         plot.y_range = y_range;
         panels.push(plot);
@@ -225,6 +102,154 @@ pub fn figure(
         _ => 3,
     };
     Figure::grid(panels, cols).with_title(title)
+}
+
+/// y range of a panel: the data with its bars, extended down to the flicker floor 0.664·B,
+/// which lies below the curve's minimum (white noise and rate random walk still add
+/// there) and would otherwise be clipped away. `k` converts to the display unit.
+fn y_range(
+    dev: &[f64],
+    lo: &[f64],
+    hi: &[f64],
+    fit: Option<&NoiseFit>,
+    k: f64,
+) -> Option<(f64, f64)> {
+    let pos = |v: &f64| v.is_finite() && *v > 0.0;
+    let data_min = dev
+        .iter()
+        .chain(lo)
+        .copied()
+        .filter(pos)
+        .fold(f64::INFINITY, f64::min);
+    let data_max = dev
+        .iter()
+        .chain(hi)
+        .copied()
+        .filter(pos)
+        .fold(0.0, f64::max);
+    let floor = fit
+        .and_then(|f| f.bias_instability)
+        .filter(|t| t.lo > 0.0)
+        .map(|t| (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt() * t.value * k);
+    (data_min.is_finite() && data_max > 0.0).then(|| {
+        let bottom = floor.filter(pos).map_or(data_min, |f| f.min(data_min));
+        (bottom / 1.3, data_max * 1.3)
+    })
+}
+
+/// The fitted model on a panel: the model curve, the asymptote of each term whose interval
+/// excludes zero (the others are listed in the noise table with their intervals), the
+/// Gauss-Markov term, and the curve's minimum marked.
+fn with_model(
+    mut plot: LogLogPlot,
+    f: &NoiseFit,
+    q: Quantity,
+    k: f64,
+    tau: &[f64],
+    dev: &[f64],
+) -> LogLogPlot {
+    let (tmin, tmax) = (
+        tau.first().copied().unwrap_or(1.0),
+        tau.last().copied().unwrap_or(10.0),
+    );
+    let model = Line::new(
+        "fitted model",
+        tau.to_vec(),
+        tau.iter().map(|&t| f.model_avar(t).sqrt() * k).collect(),
+    )
+    .with_color(Color::rgb(0x20, 0x20, 0x20));
+    plot = plot.with_line(model);
+    let grey = Color::rgb(0x70, 0x70, 0x70);
+    // Draw only terms whose interval excludes zero; the others are listed in the
+    // noise table with their intervals.
+    let significant = |t: &crate::allan::fit::Term| t.lo > 0.0;
+    let mut asym = |name: &str, term: char, v: f64, coeff: f64, exp: f64, at: f64| {
+        let l = Line::power_law(name, coeff * k, exp, tmin, tmax, 32)
+            .dashed()
+            .with_color(grey)
+            .with_label(term_label(term, q, v))
+            .with_label_at(at);
+        plot.lines.push(l);
+    };
+    let geo = |a: f64, b: f64| (a * b).sqrt();
+    if let Some(t) = f.quantization.filter(significant) {
+        asym(
+            "Q asymptote",
+            'Q',
+            t.value,
+            3f64.sqrt() * t.value,
+            -1.0,
+            tmin * 2.0,
+        );
+    }
+    if let Some(t) = f.white.filter(significant) {
+        asym(
+            "N asymptote",
+            'N',
+            t.value,
+            t.value,
+            -0.5,
+            geo(tmin, geo(tmin, tmax)),
+        );
+    }
+    if let Some(t) = f.bias_instability.filter(significant) {
+        let c = (2.0 * std::f64::consts::LN_2 / std::f64::consts::PI).sqrt();
+        asym(
+            "B asymptote",
+            'B',
+            t.value,
+            c * t.value,
+            0.0,
+            geo(tmin, tmax),
+        );
+    }
+    if let Some(t) = f.rate_random_walk.filter(significant) {
+        asym(
+            "K asymptote",
+            'K',
+            t.value,
+            t.value / 3f64.sqrt(),
+            0.5,
+            geo(geo(tmin, tmax), tmax),
+        );
+    }
+    if let Some(t) = f.rate_ramp.filter(significant) {
+        asym(
+            "R asymptote",
+            'R',
+            t.value,
+            t.value / 2f64.sqrt(),
+            1.0,
+            tmax / 2.0,
+        );
+    }
+    if let Some(gm) = f.gauss_markov.filter(|g| significant(&g.sigma)) {
+        let (s, tc) = (gm.sigma.value, gm.tau_c_s.value);
+        let y: Vec<f64> = tau
+            .iter()
+            .map(|&t| gauss_markov_avar(s, tc, t).sqrt() * k)
+            .collect();
+        plot.lines.push(
+            Line::new("Gauss-Markov term", tau.to_vec(), y)
+                .dashed()
+                .with_color(grey)
+                .with_label(format!(
+                    "GM σ = {}, T = {} s",
+                    format_sig(s * k),
+                    format_sig(tc)
+                )),
+        );
+    }
+    // Mark the curve's minimum (where bias instability is read classically).
+    if let Some((j, _)) = dev
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.is_finite() && **v > 0.0)
+        .min_by(|a, b| a.1.total_cmp(b.1))
+    {
+        plot = plot.with_annotation(Annotation::new("minimum", tau[j], dev[j]));
+    }
+    plot
 }
 
 /// Write the figure to `path`: `.png` → PNG (needs the `png` feature), anything else SVG.

@@ -370,22 +370,7 @@ impl KfGinsConfigRaw {
                 format!("expected a mapping of keys, found {}", describe(root)),
             ));
         };
-        let mut unknown = Vec::new();
-        for (k, _) in map.iter() {
-            match &k.data {
-                YamlData::Value(Scalar::String(s)) => {
-                    if !KNOWN_KEYS.contains(&s.as_ref()) {
-                        unknown.push(s.to_string());
-                    }
-                }
-                _ => {
-                    return Err(cx.malformed(
-                        cx.at(k),
-                        format!("expected a key name, found {}", describe(k)),
-                    ));
-                }
-            }
-        }
+        let unknown = unknown_keys(&cx, map)?;
         let root_at = cx.at(root);
         let req = |m, key: &str, at: &Location| req(&cx, m, key, at);
         let string = |key: &str| -> Result<String, LogError> {
@@ -500,60 +485,7 @@ impl KfGinsConfigRaw {
         let initsgstd = v3opt("initsgstd")?;
         let initsastd = v3opt("initsastd")?;
 
-        let noise = req(map, "imunoise", &root_at)?;
-        let YamlData::Mapping(nmap) = &noise.data else {
-            return Err(cx.invalid(
-                cx.at(noise),
-                format!(
-                    "`imunoise` must be a mapping (arw, vrw, …), found {}",
-                    describe(noise)
-                ),
-            ));
-        };
-        let noise_at = cx.at(noise);
-        let nstd = |key: &str| -> Result<([f64; 3], Location), LogError> {
-            let v = req(nmap, key, &noise_at)?;
-            let (a, at) = vec3(&cx, v, &format!("imunoise.{key}"))?;
-            check_nonneg(&cx, v, &format!("imunoise.{key}"), &a)?;
-            Ok((a, at))
-        };
-        let (arw, n) = nstd("arw")?;
-        if arw.iter().any(|&x| x > 100.0) {
-            return Err(cx.invalid(
-                n,
-                format!(
-                    "`imunoise.arw` {arw:?} deg/√h is implausibly large; KF-GINS expects deg/sqrt(h) (deg/h or deg/s values do not fit)"
-                ),
-            ));
-        }
-        let (vrw, n) = nstd("vrw")?;
-        if vrw.iter().any(|&x| x > 100.0) {
-            return Err(cx.invalid(
-                n,
-                format!(
-                    "`imunoise.vrw` {vrw:?} m/s/√h is implausibly large; KF-GINS expects m/s/sqrt(h)"
-                ),
-            ));
-        }
-        let (gbstd, _) = nstd("gbstd")?;
-        let (abstd, _) = nstd("abstd")?;
-        let (gsstd, _) = nstd("gsstd")?;
-        let (asstd, _) = nstd("asstd")?;
-        let ct = req(nmap, "corrtime", &noise_at)?;
-        let (corrtime, n) = number(&cx, ct, "imunoise.corrtime")?;
-        if !(corrtime > 0.0 && corrtime <= 1000.0) {
-            return Err(cx.invalid(
-                n,
-                format!(
-                    "`imunoise.corrtime` must be in (0, 1000] hours, found {corrtime}{}",
-                    if corrtime > 1000.0 {
-                        " (KF-GINS expects hours; this looks like seconds)"
-                    } else {
-                        ""
-                    }
-                ),
-            ));
-        }
+        let imunoise = imu_noise(&cx, map, &root_at)?;
         let (antlever, _) = v3("antlever")?;
         Ok((
             KfGinsConfigRaw {
@@ -578,15 +510,7 @@ impl KfGinsConfigRaw {
                 initbastd,
                 initsgstd,
                 initsastd,
-                imunoise: ImuNoiseRaw {
-                    arw,
-                    vrw,
-                    gbstd,
-                    abstd,
-                    gsstd,
-                    asstd,
-                    corrtime,
-                },
+                imunoise,
                 antlever,
             },
             unknown,
@@ -666,6 +590,104 @@ impl KfGinsConfigRaw {
         ));
         s
     }
+}
+
+/// The top-level keys that KF-GINS does not know (kept for a note); a key that is not a
+/// name is an error.
+fn unknown_keys(
+    cx: &Ctx<'_>,
+    map: &saphyr::AnnotatedMapping<'_, MarkedYaml<'_>>,
+) -> Result<Vec<String>, LogError> {
+    let mut unknown = Vec::new();
+    for (k, _) in map.iter() {
+        match &k.data {
+            YamlData::Value(Scalar::String(s)) => {
+                if !KNOWN_KEYS.contains(&s.as_ref()) {
+                    unknown.push(s.to_string());
+                }
+            }
+            _ => {
+                return Err(cx.malformed(
+                    cx.at(k),
+                    format!("expected a key name, found {}", describe(k)),
+                ));
+            }
+        }
+    }
+    Ok(unknown)
+}
+
+/// The `imunoise` mapping: noise densities, bias and scale-factor σ, correlation time;
+/// values in the wrong units (deg/h for ARW, seconds for the correlation time) refused.
+fn imu_noise(
+    cx: &Ctx<'_>,
+    map: &saphyr::AnnotatedMapping<'_, MarkedYaml<'_>>,
+    root_at: &Location,
+) -> Result<ImuNoiseRaw, LogError> {
+    let req = |m, key: &str, at: &Location| req(cx, m, key, at);
+    let noise = req(map, "imunoise", root_at)?;
+    let YamlData::Mapping(nmap) = &noise.data else {
+        return Err(cx.invalid(
+            cx.at(noise),
+            format!(
+                "`imunoise` must be a mapping (arw, vrw, …), found {}",
+                describe(noise)
+            ),
+        ));
+    };
+    let noise_at = cx.at(noise);
+    let nstd = |key: &str| -> Result<([f64; 3], Location), LogError> {
+        let v = req(nmap, key, &noise_at)?;
+        let (a, at) = vec3(cx, v, &format!("imunoise.{key}"))?;
+        check_nonneg(cx, v, &format!("imunoise.{key}"), &a)?;
+        Ok((a, at))
+    };
+    let (arw, n) = nstd("arw")?;
+    if arw.iter().any(|&x| x > 100.0) {
+        return Err(cx.invalid(
+            n,
+            format!(
+                "`imunoise.arw` {arw:?} deg/√h is implausibly large; KF-GINS expects deg/sqrt(h) (deg/h or deg/s values do not fit)"
+            ),
+        ));
+    }
+    let (vrw, n) = nstd("vrw")?;
+    if vrw.iter().any(|&x| x > 100.0) {
+        return Err(cx.invalid(
+            n,
+            format!(
+                "`imunoise.vrw` {vrw:?} m/s/√h is implausibly large; KF-GINS expects m/s/sqrt(h)"
+            ),
+        ));
+    }
+    let (gbstd, _) = nstd("gbstd")?;
+    let (abstd, _) = nstd("abstd")?;
+    let (gsstd, _) = nstd("gsstd")?;
+    let (asstd, _) = nstd("asstd")?;
+    let ct = req(nmap, "corrtime", &noise_at)?;
+    let (corrtime, n) = number(cx, ct, "imunoise.corrtime")?;
+    if !(corrtime > 0.0 && corrtime <= 1000.0) {
+        return Err(cx.invalid(
+            n,
+            format!(
+                "`imunoise.corrtime` must be in (0, 1000] hours, found {corrtime}{}",
+                if corrtime > 1000.0 {
+                    " (KF-GINS expects hours; this looks like seconds)"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    Ok(ImuNoiseRaw {
+        arw,
+        vrw,
+        gbstd,
+        abstd,
+        gsstd,
+        asstd,
+        corrtime,
+    })
 }
 
 /// A finite number from a scalar node (integers, floats, and quoted numbers as yaml-cpp

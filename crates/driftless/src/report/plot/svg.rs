@@ -3,7 +3,8 @@
 
 use std::fmt::Write as _;
 
-use super::figure::MarkerShape;
+use super::figure::{Color, MarkerShape};
+use super::geom::Pt;
 use super::scene::{Anchor, Dash, Prim, Scene, marker_polygon};
 
 const FONT_FAMILY: &str = "'DejaVu Sans', Verdana, 'Helvetica Neue', Arial, sans-serif";
@@ -111,12 +112,7 @@ fn write_prim(o: &mut String, p: &Prim) {
                 return;
             }
             o.push_str("<polyline points=\"");
-            for (i, (x, y)) in pts.iter().enumerate() {
-                if i > 0 {
-                    o.push(' ');
-                }
-                let _ = write!(o, "{},{}", num(*x), num(*y));
-            }
+            write_points(o, pts);
             let _ = write!(
                 o,
                 "\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" stroke-linejoin=\"round\"",
@@ -140,12 +136,7 @@ fn write_prim(o: &mut String, p: &Prim) {
                 return;
             }
             o.push_str("<polygon points=\"");
-            for (i, (x, y)) in pts.iter().enumerate() {
-                if i > 0 {
-                    o.push(' ');
-                }
-                let _ = write!(o, "{},{}", num(*x), num(*y));
-            }
+            write_points(o, pts);
             let _ = write!(o, "\" fill=\"{}\" stroke=\"none\"", color.to_hex());
             if *opacity < 1.0 {
                 let _ = write!(o, " fill-opacity=\"{}\"", num(*opacity));
@@ -158,43 +149,7 @@ fn write_prim(o: &mut String, p: &Prim) {
             r,
             color,
             filled,
-        } => {
-            let fill = if *filled {
-                color.to_hex()
-            } else {
-                "#ffffff".to_owned()
-            };
-            let paint = format!(
-                " fill=\"{}\" stroke=\"{}\" stroke-width=\"{}\"/>\n",
-                if *filled { fill.as_str() } else { "none" },
-                color.to_hex(),
-                if *filled { "0.8" } else { "1.4" }
-            );
-            match shape {
-                MarkerShape::None => {}
-                MarkerShape::Circle => {
-                    let _ = write!(
-                        o,
-                        "<circle cx=\"{}\" cy=\"{}\" r=\"{}\"{paint}",
-                        num(at.0),
-                        num(at.1),
-                        num(*r)
-                    );
-                }
-                _ => {
-                    if let Some(poly) = marker_polygon(*shape, *at, *r) {
-                        o.push_str("<polygon points=\"");
-                        for (i, (x, y)) in poly.iter().enumerate() {
-                            if i > 0 {
-                                o.push(' ');
-                            }
-                            let _ = write!(o, "{},{}", num(*x), num(*y));
-                        }
-                        let _ = write!(o, "\"{paint}");
-                    }
-                }
-            }
-        }
+        } => write_marker(o, *at, *shape, *r, *color, *filled),
         Prim::Text {
             at,
             text,
@@ -203,26 +158,83 @@ fn write_prim(o: &mut String, p: &Prim) {
             anchor,
             vertical,
             bold,
-        } => {
-            let (x, y) = (num(at.0), num(at.1));
+        } => write_text(o, *at, text, *size, *color, *anchor, *vertical, *bold),
+    }
+}
+
+/// Writes `x,y` pairs separated by spaces (a `points` attribute's value).
+fn write_points(o: &mut String, pts: &[Pt]) {
+    for (i, (x, y)) in pts.iter().enumerate() {
+        if i > 0 {
+            o.push(' ');
+        }
+        let _ = write!(o, "{},{}", num(*x), num(*y));
+    }
+}
+
+/// A marker: a circle, or the shape's polygon; filled, or white with a coloured ring.
+fn write_marker(o: &mut String, at: Pt, shape: MarkerShape, r: f64, color: Color, filled: bool) {
+    let fill = if filled {
+        color.to_hex()
+    } else {
+        "#ffffff".to_owned()
+    };
+    let paint = format!(
+        " fill=\"{}\" stroke=\"{}\" stroke-width=\"{}\"/>\n",
+        if filled { fill.as_str() } else { "none" },
+        color.to_hex(),
+        if filled { "0.8" } else { "1.4" }
+    );
+    match shape {
+        MarkerShape::None => {}
+        MarkerShape::Circle => {
             let _ = write!(
                 o,
-                "<text x=\"{x}\" y=\"{y}\" font-size=\"{}\" fill=\"{}\"",
-                num(*size),
-                color.to_hex()
+                "<circle cx=\"{}\" cy=\"{}\" r=\"{}\"{paint}",
+                num(at.0),
+                num(at.1),
+                num(r)
             );
-            match anchor {
-                Anchor::Start => {}
-                Anchor::Middle => o.push_str(" text-anchor=\"middle\""),
-                Anchor::End => o.push_str(" text-anchor=\"end\""),
+        }
+        _ => {
+            if let Some(poly) = marker_polygon(shape, at, r) {
+                o.push_str("<polygon points=\"");
+                write_points(o, &poly);
+                let _ = write!(o, "\"{paint}");
             }
-            if *bold {
-                o.push_str(" font-weight=\"bold\"");
-            }
-            if *vertical {
-                let _ = write!(o, " transform=\"rotate(-90 {x} {y})\"");
-            }
-            let _ = writeln!(o, ">{}</text>", xml_escape(text));
         }
     }
+}
+
+/// A text element with its anchor, weight and (for a y axis title) rotation.
+#[allow(clippy::too_many_arguments)]
+fn write_text(
+    o: &mut String,
+    at: Pt,
+    text: &str,
+    size: f64,
+    color: Color,
+    anchor: Anchor,
+    vertical: bool,
+    bold: bool,
+) {
+    let (x, y) = (num(at.0), num(at.1));
+    let _ = write!(
+        o,
+        "<text x=\"{x}\" y=\"{y}\" font-size=\"{}\" fill=\"{}\"",
+        num(size),
+        color.to_hex()
+    );
+    match anchor {
+        Anchor::Start => {}
+        Anchor::Middle => o.push_str(" text-anchor=\"middle\""),
+        Anchor::End => o.push_str(" text-anchor=\"end\""),
+    }
+    if bold {
+        o.push_str(" font-weight=\"bold\"");
+    }
+    if vertical {
+        let _ = write!(o, " transform=\"rotate(-90 {x} {y})\"");
+    }
+    let _ = writeln!(o, ">{}</text>", xml_escape(text));
 }
