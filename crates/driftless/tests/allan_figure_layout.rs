@@ -136,7 +136,8 @@ fn boxes(svg_text: &str) -> Boxes {
     Boxes { labels, legends }
 }
 
-/// Does the segment a–b pass through the interior of `r` (shrunk by `inset` px)?
+/// Does the segment a–b pass through the interior of `r` (shrunk by `inset` px)? Sampled
+/// every 0.1 px along the segment.
 fn crosses(a: (f64, f64), b: (f64, f64), r: Rect, inset: f64) -> bool {
     let (x0, y0, x1, y1) = (
         r.0 + inset,
@@ -144,32 +145,12 @@ fn crosses(a: (f64, f64), b: (f64, f64), r: Rect, inset: f64) -> bool {
         r.0 + r.2 - inset,
         r.1 + r.3 - inset,
     );
-    if x1 <= x0 || y1 <= y0 {
-        return false;
-    }
-    // Liang–Barsky clipping of the segment against the rectangle.
-    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
-    let (mut t0, mut t1) = (0.0f64, 1.0f64);
-    for (p, q) in [
-        (-dx, a.0 - x0),
-        (dx, x1 - a.0),
-        (-dy, a.1 - y0),
-        (dy, y1 - a.1),
-    ] {
-        if p == 0.0 {
-            if q < 0.0 {
-                return false;
-            }
-        } else {
-            let t = q / p;
-            if p < 0.0 {
-                t0 = t0.max(t);
-            } else {
-                t1 = t1.min(t);
-            }
-        }
-    }
-    t0 < t1
+    let steps = ((b.0 - a.0).hypot(b.1 - a.1) / 0.1).ceil().max(1.0) as usize;
+    (0..=steps).any(|k| {
+        let t = k as f64 / steps as f64;
+        let (x, y) = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+        x > x0 && x < x1 && y > y0 && y < y1
+    })
 }
 
 fn overlap(a: Rect, b: Rect) -> bool {
@@ -199,17 +180,7 @@ fn curves(svg_text: &str, legends: &[Rect]) -> Vec<Vec<(f64, f64)>> {
         if !keys.iter().any(|k| l.contains(k.as_str())) {
             continue;
         }
-        let pts: Vec<(f64, f64)> = l
-            .split("points=\"")
-            .nth(1)
-            .and_then(|s| s.split('"').next())
-            .unwrap_or("")
-            .split(' ')
-            .filter_map(|p| {
-                let (a, b) = p.split_once(',')?;
-                Some((a.parse().ok()?, b.parse().ok()?))
-            })
-            .collect();
+        let pts = svg::polyline_points(l);
         if pts.len() >= 2 && !legends.iter().any(|r| inside(&pts, *r)) {
             out.push(pts);
         }
