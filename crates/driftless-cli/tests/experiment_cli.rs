@@ -96,5 +96,31 @@ fn printed_builtin_scenario_runs_one_run() {
     assert!((cell - json).abs() <= 0.5 + 0.01 * json, "{cell} vs {json}");
     let md = std::fs::read_to_string(out_dir.join("table1.md")).unwrap();
     assert!(md.contains("| #9 |") && md.contains("8.4×"), "{md}");
+    // Every Markdown table keeps its header's cell count: the `mean |·|` summary rows
+    // escape their bars.
+    let mut tables = 0;
+    let mut header_cells = None;
+    for line in md.lines() {
+        if !line.starts_with('|') {
+            header_cells = None;
+            continue;
+        }
+        let n = markdown_cells(line);
+        match header_cells {
+            None => {
+                header_cells = Some(n);
+                tables += 1;
+            }
+            Some(h) => assert_eq!(n, h, "{line}"),
+        }
+    }
+    assert!(tables >= 5, "{tables} tables in table1.md");
+    assert!(md.contains("| mean \\|·\\| |"), "{md}");
     assert!(md.contains("## Where more compensation did worse"), "{md}");
+}
+
+/// Cells of a Markdown table row such as `| mean \|·\| | 1.5 |` (two): its bars not
+/// escaped by a backslash, less one.
+fn markdown_cells(line: &str) -> usize {
+    line.trim().replace("\\|", "").matches('|').count() - 1
 }

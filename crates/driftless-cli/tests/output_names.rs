@@ -33,6 +33,17 @@ fn a_figure_name_that_is_neither_svg_nor_png_is_refused_before_the_analysis() {
     for cmd in [
         vec!["allan".to_string(), log.display().to_string()],
         vec!["thermal".into(), "soak".into(), log.display().to_string()],
+        vec![
+            "calibrate".into(),
+            "six-position".into(),
+            log.display().to_string(),
+        ],
+        vec![
+            "calibrate".into(),
+            "multi-position".into(),
+            log.display().to_string(),
+            log.display().to_string(),
+        ],
     ] {
         let out = bin()
             .args(&cmd)

@@ -416,6 +416,29 @@ fn plot_png_error_is_typed() {
     }
 }
 
+/// A figure name that is neither `.svg` nor `.png` is refused, naming the file, and
+/// nothing is written (SVG text used to land in a `.jpg`); `.SVG` is SVG.
+#[test]
+fn write_figure_refuses_other_formats() {
+    let dir = std::env::temp_dir().join(format!("driftless-plot-ext-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fig = Figure::single(allan_like());
+    for name in ["x.jpg", "x.pdf", "x"] {
+        let path = dir.join(name);
+        let err = driftless::report::plot::write_figure(&fig, &path).unwrap_err();
+        assert!(
+            matches!(err, PlotError::UnsupportedFormat { .. }),
+            "{name}: {err}"
+        );
+        assert!(err.to_string().contains(name), "{err}");
+        assert!(!path.exists(), "{name} written");
+    }
+    let svg = dir.join("x.SVG");
+    driftless::report::plot::write_figure(&fig, &svg).unwrap();
+    assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 #[ignore = "writes /tmp/plot_allan_like.svg for viewing"]
 fn plot_dump_allan_like() {

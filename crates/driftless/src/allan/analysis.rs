@@ -74,7 +74,7 @@ pub struct ChannelResult {
     /// samples of the longest segment), per point; NaN where fewer than
     /// [`MIN_ACF_BLOCKS`] blocks exist. ≈ 0 for white noise, negative where quantization
     /// dominates, positive where the sensor's own filtering colours the noise (see
-    /// [`super::fit::auto_fit_start`]).
+    /// [`super::fit::auto_range_candidates`]).
     #[serde(default)]
     pub rate_acf1: Vec<f64>,
 }

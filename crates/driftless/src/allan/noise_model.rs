@@ -159,7 +159,7 @@ pub enum NoiseModelError {
 /// How [`NoiseModel::from_curves_with`] chooses the fit range and checks the terms.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModelOptions {
-    /// A user-given τ range; None: automatic ([`auto_fit_start`]).
+    /// A user-given τ range; None: automatic ([`super::fit::auto_range_candidates`]).
     pub fit_range: Option<FitRangeSpec>,
     /// Resolution step of each curve's rate samples (same order as the curves), when
     /// the samples are quantized ([`super::checks::resolution_step`]).
@@ -210,7 +210,7 @@ impl NoiseModel {
 
     /// Fit every channel's Allan curve (an OADEV-family [`ChannelResult`]) and collect the
     /// model. The EDF of each point follows the dominant term's noise exponent
-    /// ([`fit_noise_with_edf`] with [`ChannelResult::edf_for_alpha`]); the classic slope
+    /// ([`super::fit::fit_noise_with_edf`] with [`ChannelResult::edf_for_alpha`]); the classic slope
     /// readings are stored alongside. `quantities[i]` belongs to `curves[i]`.
     pub fn from_curves(
         source: &str,
@@ -232,7 +232,7 @@ impl NoiseModel {
     /// [`NoiseModel::from_curves`] over a chosen τ range, with physically possible terms
     /// only:
     /// * the fit range is `opts.fit_range` or, by default, the curve without the short τ
-    ///   where the sensor's own filtering colours the noise ([`auto_fit_start`] on
+    ///   where the sensor's own filtering colours the noise ([`super::fit::auto_range_candidates`] on
     ///   [`ChannelResult::rate_acf1`]);
     /// * a Gauss-Markov correlation time is searched between a few sample intervals and a
     ///   tenth of the record ([`fit_noise_with_edf_opts`]); one at a bound is reported

@@ -3,7 +3,7 @@
 //! temperature plateaus (temperature, settled or not, dwell), with findings (missing
 //! positions, unsettled plateaus, ambiguous segments) named by their time span. A
 //! [`Segmentation`] becomes the segment manifest of [`crate::sim::chamber_manifest`]
-//! ([`Segmentation::to_manifest`]), so the six-position and soak calibrations
+//! ([`Segmentation::manifest_of`]), so the six-position and soak calibrations
 //! ([`crate::calib::six_position`], [`crate::thermal::soak`]) run on it unchanged.
 //!
 //! # Motion

@@ -176,10 +176,10 @@ pub fn markdown(header: &[String], rows: &[Vec<String>]) -> String {
     s
 }
 
-/// CSV (RFC 4180 quoting where needed).
+/// CSV (RFC 4180: a field holding a comma, a quote, CR or LF is quoted, quotes doubled).
 pub fn csv(header: &[String], rows: &[Vec<String>]) -> String {
     let q = |f: &String| {
-        if f.contains([',', '"', '\n']) {
+        if f.contains([',', '"', '\n', '\r']) {
             format!("\"{}\"", f.replace('"', "\"\""))
         } else {
             f.clone()
@@ -502,5 +502,24 @@ mod tests {
             assert_eq!(cells(line), 3, "{line}");
         }
         assert!(md.contains("mean \\|·\\|"), "{md}");
+    }
+
+    /// RFC 4180: fields with a comma, a quote, CR or LF are quoted (a bare CR would end
+    /// the record for many readers), quotes doubled; plain fields stay as they are.
+    #[test]
+    fn csv_quotes_comma_quote_cr_and_lf() {
+        let header: Vec<String> = ["case", "note"].map(String::from).to_vec();
+        let rows = vec![
+            ["a", "x\ry"].map(String::from).to_vec(),
+            ["b", "x\ny"].map(String::from).to_vec(),
+            ["c", "x,y"].map(String::from).to_vec(),
+            ["d", "say \"hi\""].map(String::from).to_vec(),
+            ["e", "plain"].map(String::from).to_vec(),
+        ];
+        let out = csv(&header, &rows);
+        assert_eq!(
+            out,
+            "case,note\na,\"x\ry\"\nb,\"x\ny\"\nc,\"x,y\"\nd,\"say \"\"hi\"\"\"\ne,plain\n"
+        );
     }
 }

@@ -69,17 +69,20 @@ pub fn polylines(svg: &str, color: Color) -> Vec<Vec<(f64, f64)>> {
     let stroke = format!("stroke=\"{}\"", color.to_hex());
     svg.lines()
         .filter(|l| l.starts_with("<polyline") && l.contains(&stroke))
-        .map(|l| {
-            l.split("points=\"")
-                .nth(1)
-                .and_then(|s| s.split('"').next())
-                .unwrap_or("")
-                .split(' ')
-                .filter_map(|p| {
-                    let (a, b) = p.split_once(',')?;
-                    Some((a.parse().ok()?, b.parse().ok()?))
-                })
-                .collect()
+        .map(polyline_points)
+        .collect()
+}
+
+/// The points of one `<polyline>` element line.
+pub fn polyline_points(line: &str) -> Vec<(f64, f64)> {
+    line.split("points=\"")
+        .nth(1)
+        .and_then(|s| s.split('"').next())
+        .unwrap_or("")
+        .split(' ')
+        .filter_map(|p| {
+            let (a, b) = p.split_once(',')?;
+            Some((a.parse().ok()?, b.parse().ok()?))
         })
         .collect()
 }

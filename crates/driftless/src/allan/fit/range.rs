@@ -12,7 +12,7 @@ pub enum RangeSource {
     /// The whole curve.
     Full,
     /// Short τ left out automatically where the averaged rates are correlated
-    /// ([`auto_fit_start`]).
+    /// ([`auto_range_candidates`]).
     Auto,
     /// Given by the user (`--fit-range`).
     User,

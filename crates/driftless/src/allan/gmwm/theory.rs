@@ -3,7 +3,7 @@
 //! Sampled rate data y_t (interval τ0), averaging length m samples, τ = m·τ0. The Haar
 //! MODWT coefficient at level j (filter width L_j = 2m, m = 2^{j−1}) is half the
 //! difference of two adjacent m-sample means, W = (ȳ_b − ȳ_a)/2, so the wavelet variance
-//! is ν²(τ) = E[W²] = σ²_A(τ)/2, half the Allan variance at the same τ (Percival &
+//! is ν²(τ) = E\[W²\] = σ²_A(τ)/2, half the Allan variance at the same τ (Percival &
 //! Guttorp 1994; Percival & Walden 2000, §8.6). Each formula below is the exact Allan
 //! variance of the *discrete* process at integer m, halved:
 //!

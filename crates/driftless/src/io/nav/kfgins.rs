@@ -1333,8 +1333,8 @@ fn commit_outputs(files: [AtomicFile; 3], names: &[String; 3]) -> Result<(), Log
 
 /// KF-GINS's three output files, written row by row or block by block — e.g. on one
 /// thread while a filter on another produces the rows
-/// ([`crate::nav::filter::run_forward_observed`]). Each file has its own [`LineBuf`],
-/// written to the file in chunks of [`CHUNK`] bytes.
+/// ([`crate::nav::filter::run_forward_observed`]). Each file has its own line buffer,
+/// written to the file in chunks of 512 KiB.
 pub struct KfGinsOutputWriter {
     files: [AtomicFile; 3],
     bufs: [Box<LineBuf>; 3],

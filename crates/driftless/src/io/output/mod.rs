@@ -1,9 +1,9 @@
 //! Output files: every file driftless writes goes through this module, so that a run that
 //! fails or is interrupted leaves every earlier file intact and no complete-looking new one.
 //!
-//! * [`file`]: [`AtomicFile`] — written to a temporary file beside the destination, flushed,
+//! * [`file`](mod@file): [`AtomicFile`] — written to a temporary file beside the destination, flushed,
 //!   synced and renamed over the final name on [`AtomicFile::commit`]; dropped without a
-//!   commit (an error, a panic), the temporary file is removed. [`write`] for whole
+//!   commit (an error, a panic), the temporary file is removed. [`write()`] for whole
 //!   buffers.
 //! * [`guard`]: refusals before any work — an output that is one of the inputs (same device
 //!   and inode, through links and `./`), an output folder that already holds files.

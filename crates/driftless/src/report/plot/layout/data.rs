@@ -75,7 +75,11 @@ pub(super) fn draw_lines(
                 opacity: 1.0,
             });
         }
-        obstacles.add_runs(&runs);
+        if line.style == LineStyle::Solid {
+            obstacles.add_runs(&runs);
+        } else {
+            obstacles.add_guide_runs(&runs);
+        }
         line_runs.push(runs);
     }
     line_runs
@@ -191,7 +195,7 @@ pub(super) fn draw_error_bars(
                 });
             }
         }
-        obstacles.segments.push((a, b));
+        obstacles.guides.push((a, b));
     }
 }
 

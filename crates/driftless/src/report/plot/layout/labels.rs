@@ -12,12 +12,32 @@ use super::{LABEL_SIZE, MARKER_R, MAX_OBSTACLES, TEXT, fit_text};
 /// Things that labels and the legend should not cover.
 #[derive(Default)]
 pub(super) struct Obstacles {
+    /// The curves themselves (series' connecting lines, solid lines such as a fitted
+    /// model): a label crosses one only where no place is free of them.
     pub(super) segments: Vec<(Pt, Pt)>,
+    /// Guides (dashed or dotted reference lines such as asymptotes, error bars): better
+    /// not covered, but a label may cross one rather than a curve.
+    pub(super) guides: Vec<(Pt, Pt)>,
     pub(super) points: Vec<Pt>,
     pub(super) boxes: Vec<Rect>,
 }
 
+/// Clutter score of a label crossing a curve segment: more than a label pushed off its
+/// line to stay inside the plot area (500), less than covering another label or the
+/// legend ([`BOX_HIT`]); a marker costs 40, a guide 25.
+const CURVE_HIT: f64 = 600.0;
+/// Clutter score of covering another label, the legend or a bar.
+const BOX_HIT: f64 = 10_000.0;
+
 impl Obstacles {
+    pub(super) fn add_guide_runs(&mut self, runs: &[Vec<Pt>]) {
+        for r in runs {
+            for w in r.windows(2) {
+                self.guides.push((w[0], w[1]));
+            }
+        }
+    }
+
     pub(super) fn add_runs(&mut self, runs: &[Vec<Pt>]) {
         for r in runs {
             for w in r.windows(2) {
@@ -35,6 +55,7 @@ impl Obstacles {
             }
         }
         thin(&mut self.segments);
+        thin(&mut self.guides);
         thin(&mut self.points);
     }
 
@@ -46,14 +67,16 @@ impl Obstacles {
         for b in &self.boxes {
             let a = r.overlap_area(b);
             if a > 0.0 {
-                s += 1000.0 + a;
+                s += BOX_HIT + a;
             }
         }
-        for &(a, b) in &self.segments {
-            if segment_hits_rect(a, b, r) {
-                s += 25.0;
-            } else if segment_hits_rect(a, b, &near) {
-                s += 3.0;
+        for (segments, hit) in [(&self.segments, CURVE_HIT), (&self.guides, 25.0)] {
+            for &(a, b) in segments {
+                if segment_hits_rect(a, b, r) {
+                    s += hit;
+                } else if segment_hits_rect(a, b, &near) {
+                    s += 3.0;
+                }
             }
         }
         let grown = r.inflate(MARKER_R);
@@ -169,7 +192,7 @@ pub(super) fn place_annotation_label(
     let (w, h) = (text_width(text, LABEL_SIZE) + 6.0, LABEL_SIZE + 6.0);
     let inner = area.inflate(-2.0);
     let mut best: Option<(f64, Rect)> = None;
-    for gap in [7.0, 16.0, 28.0] {
+    for gap in [7.0, 16.0, 28.0, 44.0] {
         for (sx, sy) in [(1.0, -1.0), (-1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
             let x = if sx > 0.0 { p.0 + gap } else { p.0 - gap - w };
             let y = if sy < 0.0 { p.1 - gap - h } else { p.1 + gap };
@@ -215,7 +238,7 @@ pub(super) fn place_label(
         return None;
     }
     const N: usize = 48;
-    const GAP: f64 = 3.0;
+    const GAPS: [f64; 3] = [3.0, 14.0, 28.0];
     let inner = area.inflate(-2.0);
     let mut best: Option<(f64, Rect)> = None;
     let mut seg_i = 0;
@@ -230,12 +253,13 @@ pub(super) fn place_label(
         let t = ((s - acc) / len).clamp(0.0, 1.0);
         let p = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
         let (dx, dy) = ((b.0 - a.0) / len, (b.1 - a.1) / len);
-        for side in [-1.0, 1.0] {
+        // Beside the line, or further out where a curve runs beside it.
+        for (side, gap) in [-1.0, 1.0].into_iter().flat_map(|s| GAPS.map(|g| (s, g))) {
             let n = (-dy * side, dx * side);
             let ext = n.0.abs() * w / 2.0 + n.1.abs() * h / 2.0;
-            let c = (p.0 + n.0 * (GAP + ext), p.1 + n.1 * (GAP + ext));
+            let c = (p.0 + n.0 * (gap + ext), p.1 + n.1 * (gap + ext));
             let mut r = Rect::new(c.0 - w / 2.0, c.1 - h / 2.0, w, h);
-            let mut score = 0.0;
+            let mut score = gap - GAPS[0];
             if !inner.contains_rect(&r) {
                 r = clamp_into(r, area);
                 score += 500.0;
