@@ -138,6 +138,7 @@ pub mod eval;
 pub mod experiment;
 pub mod io;
 pub mod nav;
+pub mod numeric;
 pub mod report;
 pub mod sim;
 pub mod thermal;

@@ -528,13 +528,9 @@ fn check_input(inp: &SegmentInput) -> Result<f64, SegmentError> {
     Ok(1.0 / dt)
 }
 
+/// Upper median of `v`; 0 when empty.
 fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    let mid = v.len() / 2;
-    v.select_nth_unstable_by(mid, f64::total_cmp);
-    v[mid]
+    crate::numeric::upper_median(&mut v).unwrap_or(0.0)
 }
 
 /// Prefix sums of the columns, for means over sample ranges.
@@ -1355,7 +1351,7 @@ mod tests {
                 t.push(t.len() as f64 / fs);
                 let sign = if motion && i % 2 == 0 { -1.0 } else { 1.0 };
                 for j in 0..3 {
-                    let e = crate::sim::rng::splitmix64(&mut seed) as f64 / u64::MAX as f64 - 0.5;
+                    let e = crate::numeric::splitmix64(&mut seed) as f64 / u64::MAX as f64 - 0.5;
                     a[j].push(sign * f[j] + 1e-3 * e);
                     g[j].push(sign * w[j] + 1e-4 * e);
                 }

@@ -579,14 +579,15 @@ fn weighted_fit(
     };
     let fit = lsq::linear(&j, &y, m, n).map_err(lsq_err)?;
     let (jtj, _) = lsq::normal_equations(&j, &y, m, n);
-    let l = lsq::cholesky(&jtj, n).ok_or_else(|| lsq_err(LsqError::Unobservable { param: 0 }))?;
+    let l = crate::numeric::cholesky(&jtj, n)
+        .ok_or_else(|| lsq_err(LsqError::Unobservable { param: 0 }))?;
     let chi2: f64 = (0..m)
         .map(|r| {
             let pred: f64 = (0..n).map(|c| j[r * n + c] * fit.params[c]).sum();
             (y[r] - pred).powi(2)
         })
         .sum();
-    let cov = lsq::cholesky_inverse(&l, n);
+    let cov = crate::numeric::cholesky_inverse(&l, n);
     Ok((fit.params, cov, chi2))
 }
 

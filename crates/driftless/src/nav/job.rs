@@ -470,6 +470,7 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
     })
 }
 
+/// Upper median of the positive epoch intervals, s (NaN when there are none).
 fn median_interval(imu: &ImuStream) -> f64 {
     let mut d: Vec<f64> = imu
         .epochs
@@ -477,11 +478,7 @@ fn median_interval(imu: &ImuStream) -> f64 {
         .map(|e| e.dt_s)
         .filter(|d| *d > 0.0)
         .collect();
-    if d.is_empty() {
-        return f64::NAN;
-    }
-    d.sort_by(f64::total_cmp);
-    d[d.len() / 2]
+    crate::numeric::upper_median(&mut d).unwrap_or(f64::NAN)
 }
 
 /// `auto:NxL` outages: chosen on the GNSS fixes inside the IMU span (the only reference of

@@ -389,12 +389,11 @@ impl ImuStream {
     }
 }
 
-/// Median of the successive differences of a strictly increasing series (len ≥ 2).
+/// Median of the successive differences of a strictly increasing series (len ≥ 2; NaN
+/// otherwise).
 fn median_diff(time_s: &[f64]) -> f64 {
     let mut d: Vec<f64> = time_s.windows(2).map(|w| w[1] - w[0]).collect();
-    let mid = d.len() / 2;
-    let (_, m, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
-    *m
+    crate::numeric::upper_median(&mut d).unwrap_or(f64::NAN)
 }
 
 /// Checks time stamps (already shifted) and returns the nominal interval and the gaps.

@@ -323,14 +323,9 @@ fn quantile(v: &[f64], q: f64) -> f64 {
     v[i.min(v.len() - 1)]
 }
 
+/// Median of `v` (mean of the middle two for even lengths; reorders it); 0 when empty.
 fn median_of(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        0.0
-    } else {
-        0.5 * (v[(n - 1) / 2] + v[n / 2])
-    }
+    crate::numeric::median(v).unwrap_or(0.0)
 }
 
 /// Least-squares slope of y on t over `range`, per second (0 with < 2 distinct times).

@@ -592,27 +592,17 @@ pub fn fit_correlated(
     fit_impl(t_c, y, Some(&sigma), Some(&l), opts)
 }
 
-/// Lower-triangular L with C = LLᵀ, or `None` when C is not symmetric positive definite.
+/// Lower-triangular L with C = LLᵀ ([`crate::numeric::cholesky`]), or `None` when C is
+/// not symmetric (to 1e-12 of √(C_ii C_jj)) or not positive definite.
 fn cholesky(c: &[f64], n: usize) -> Option<Vec<f64>> {
-    let mut l = vec![0.0; n * n];
     for i in 0..n {
-        for j in 0..=i {
+        for j in 0..i {
             if (c[i * n + j] - c[j * n + i]).abs() > 1e-12 * (c[i * n + i] * c[j * n + j]).sqrt() {
                 return None;
             }
-            let s: f64 = (0..j).map(|k| l[i * n + k] * l[j * n + k]).sum();
-            if i == j {
-                let d = c[i * n + i] - s;
-                if !(d > 0.0 && d.is_finite()) {
-                    return None;
-                }
-                l[i * n + i] = d.sqrt();
-            } else {
-                l[i * n + j] = (c[i * n + j] - s) / l[j * n + j];
-            }
         }
     }
-    Some(l)
+    crate::numeric::cholesky(c, n)
 }
 
 /// Data whose largest magnitude lies outside 2^±[`SAFE_EXPONENT`] are fitted scaled by a
