@@ -2,7 +2,7 @@
 //! axis that points up, rate-table rotations (axis, rate, sense, revolutions) and
 //! temperature plateaus (temperature, settled or not, dwell), with findings (missing
 //! positions, unsettled plateaus, ambiguous segments) named by their time span. A
-//! [`Segmentation`] becomes the segment manifest of [`crate::sim::chamber_manifest`]
+//! [`Segmentation`] becomes the segment manifest of [`super::protocol`]
 //! ([`Segmentation::to_manifest`]), so the six-position and soak calibrations
 //! ([`crate::calib::six_position`], [`crate::thermal::soak`]) run on it unchanged.
 //!
@@ -74,11 +74,11 @@
 use driftless_model::linalg::{Vec3, norm};
 use serde::Serialize;
 
-use super::static_detect::{StaticDetectOptions, variance_profile};
-use crate::nav::earth;
-use crate::sim::chamber_manifest::{
+use super::protocol::{
     BodyAxis, ChamberManifest, MANIFEST_VERSION, Segment, SegmentKind, SignedAxis,
 };
+use super::static_detect::{StaticDetectOptions, variance_profile};
+use crate::nav::earth;
 
 /// Settings of [`segment_log`] (module docs for each threshold).
 #[derive(Clone, Debug, PartialEq)]

@@ -95,10 +95,9 @@ use driftless_model::calib::{ImuCalibration, TriadCalibration};
 use driftless_model::linalg::{Mat3, Vec3};
 
 use super::lsq::{self, LsqError};
+use super::protocol::{BodyAxis, ChamberManifest, SegmentKind, SignedAxis};
 use super::quality::FitQuality;
 use crate::nav::earth;
-use crate::sim::chamber::{BodyAxis, ChamberManifest, SegmentKind, SignedAxis};
-use crate::sim::sensor::{OutputKind, SensorOutput};
 
 /// Mean raw output of one static position.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -874,35 +873,6 @@ fn triad_stats(cols: &[&[f64]; 3], range: std::ops::Range<usize>, scale: f64) ->
 }
 
 impl SixPositionInput {
-    /// The position and rate segments at set temperature `set_temperature_c` of a chamber
-    /// manifest, averaged from a simulated (or recorded, same layout) output: rates are
-    /// used as they are, increments divided by Δt. Samples per segment:
-    /// [`crate::sim::chamber::Segment::sample_range`].
-    pub fn from_chamber(
-        manifest: &ChamberManifest,
-        out: &SensorOutput,
-        set_temperature_c: f64,
-    ) -> Result<SixPositionInput, SixPositionError> {
-        let fs = manifest.sample_rate_hz;
-        if !(fs > 0.0 && out.dt_s > 0.0) || ((1.0 / fs) - out.dt_s).abs() > 1e-9 * out.dt_s {
-            return Err(SixPositionError::Invalid(format!(
-                "manifest rate {fs} Hz does not match the output's Δt = {} s",
-                out.dt_s
-            )));
-        }
-        let scale = match out.kind {
-            OutputKind::Rates => 1.0,
-            OutputKind::Increments => 1.0 / out.dt_s,
-        };
-        SixPositionInput::from_manifest_columns(
-            manifest,
-            out.accel.each_ref().map(Vec::as_slice),
-            out.gyro.each_ref().map(Vec::as_slice),
-            scale,
-            set_temperature_c,
-        )
-    }
-
     /// The positions and rate segments of `manifest` at `set_temperature_c` from raw
     /// sample columns (x, y, z) indexed as the manifest's samples (sample k at
     /// k/`sample_rate_hz` from the protocol start), each multiplied by `scale` (1 for
