@@ -82,7 +82,9 @@ use crate::nav::earth;
 
 mod manifest;
 mod plateau;
+mod runs;
 use plateau::*;
+use runs::RunClassifier;
 
 /// Settings of [`segment_log`] (module docs for each threshold).
 #[derive(Clone, Debug, PartialEq)]
@@ -633,14 +635,21 @@ pub fn segment_log(
         .map(|k| va.sigma[k] < th_a && vg.sigma[k] < th_g)
         .collect();
     let sums = Sums::new(inp.accel_m_s2, inp.gyro_rad_s, inp.temperature_c);
-    let mut findings = Vec::new();
-    let mut statics = Vec::new();
-    let mut rotations = Vec::new();
-    let mut inferred_rates: Vec<f64> = Vec::new();
-    let min_static = ((opts.min_static_s * fs).round() as usize).max(2);
-    let min_rot = ((opts.min_rotation_s * fs).round() as usize).max(2);
-    let trim = (opts.trim_s * fs).round() as usize;
-    let tol = opts.orientation_tolerance_deg;
+    let mut runs = RunClassifier {
+        inp,
+        opts,
+        fs,
+        sums: &sums,
+        min_static: ((opts.min_static_s * fs).round() as usize).max(2),
+        min_rot: ((opts.min_rotation_s * fs).round() as usize).max(2),
+        trim: (opts.trim_s * fs).round() as usize,
+        tol: opts.orientation_tolerance_deg,
+        findings: Vec::new(),
+        statics: Vec::new(),
+        rotations: Vec::new(),
+        inferred_rates: Vec::new(),
+    };
+    let tol = runs.tol;
     let mut k0 = 0;
     while k0 < n {
         if !quiet[k0] {
@@ -653,189 +662,17 @@ pub fn segment_log(
         }
         let (a, b) = (k0, k1);
         k0 = k1;
-        if b - a < min_static.min(min_rot) {
+        if b - a < runs.min_static.min(runs.min_rot) {
             continue;
         }
-        let (a, b) = extend_run(inp, a, b, (opts.window_s * fs).round() as usize);
-        k0 = k0.max(b);
-        let w = sums.gyro(a, b);
-        let rate_deg_s = norm(w).to_degrees();
-        if rate_deg_s < opts.static_max_rate_deg_s {
-            if b - a < min_static {
-                continue;
-            }
-            let (a, b) = if b - a >= 2 * trim + min_static {
-                (a + trim, b - trim)
-            } else {
-                (a, b)
-            };
-            let f = sums.accel(a, b);
-            let (axis, tilt) = nearest_axis(f);
-            let (up, role) = if tilt <= tol {
-                (Some(axis), StaticRole::Position)
-            } else {
-                if tilt <= 2.0 * tol {
-                    findings.push(Finding {
-                        kind: FindingKind::Ambiguous,
-                        start_s: t[a],
-                        end_s: t[b - 1],
-                        message: format!(
-                            "static {}: {tilt:.1}° from {axis} up, beyond the {tol}° \
-                             orientation tolerance; not used (re-level the fixture or raise the \
-                             tolerance)",
-                            span(a, b).label()
-                        ),
-                    });
-                }
-                (None, StaticRole::Other)
-            };
-            statics.push(StaticSegment {
-                span: span(a, b),
-                up,
-                tilt_deg: tilt,
-                mean_accel_m_s2: f,
-                role,
-                position_tail: None,
-                plateau: None,
-            });
-        } else if rate_deg_s >= opts.rotation_min_rate_deg_s {
-            if b - a < min_rot {
-                continue;
-            }
-            let j = (0..3)
-                .max_by(|&x, &y| w[x].abs().total_cmp(&w[y].abs()))
-                .unwrap_or(2);
-            let off = (0..3)
-                .filter(|&i| i != j)
-                .map(|i| w[i].abs())
-                .fold(0.0, f64::max);
-            let label = span(a, b).label();
-            if off > 0.05 * w[j].abs() {
-                findings.push(Finding {
-                    kind: FindingKind::Ambiguous,
-                    start_s: t[a],
-                    end_s: t[b - 1],
-                    message: format!(
-                        "rotation {label} at {rate_deg_s:.2} deg/s is not about one body axis \
-                         (cross-axis rate {:.1} % of it); not used (mount the IMU with an axis \
-                         on the table axis)",
-                        100.0 * off / w[j].abs()
-                    ),
-                });
-                continue;
-            }
-            let axis = BodyAxis::ALL[j];
-            let measured = w[j];
-            let commanded_abs_deg = match opts.table_rate_deg_s {
-                Some(r) => r,
-                None => {
-                    let r = (measured.abs().to_degrees() / opts.rate_round_deg_s).round()
-                        * opts.rate_round_deg_s;
-                    if r > 0.0 && !inferred_rates.contains(&r) {
-                        inferred_rates.push(r);
-                        findings.push(Finding {
-                            kind: FindingKind::RateInferred { rate_deg_s: r },
-                            start_s: t[a],
-                            end_s: t[b - 1],
-                            message: format!(
-                                "rotation {label}: table rate taken as {r} deg/s (measured \
-                                 {:.3} deg/s rounded to {} deg/s); state it with the table \
-                                 rate option if it differs",
-                                measured.abs().to_degrees(),
-                                opts.rate_round_deg_s
-                            ),
-                        });
-                    }
-                    r
-                }
-            };
-            let rel = (measured.abs().to_degrees() - commanded_abs_deg).abs() / commanded_abs_deg;
-            let commanded = if commanded_abs_deg > 0.0 && rel <= opts.rate_tolerance {
-                Some(commanded_abs_deg.to_radians() * measured.signum())
-            } else {
-                findings.push(Finding {
-                    kind: FindingKind::Ambiguous,
-                    start_s: t[a],
-                    end_s: t[b - 1],
-                    message: format!(
-                        "rotation {label} about {}: measured {:.3} deg/s differs from the table \
-                         rate {commanded_abs_deg} deg/s by {:.1} % (> {:.1} %); not used (state \
-                         the table rate, or raise the rate tolerance)",
-                        ['x', 'y', 'z'][j],
-                        measured.to_degrees(),
-                        100.0 * rel,
-                        100.0 * opts.rate_tolerance
-                    ),
-                });
-                None
-            };
-            // Whole revolutions of the commanded rate about the centre when the run is
-            // longer (ramp tails cut symmetrically); a run shorter than its nearest whole
-            // number of revolutions (the centred variance window shortens a run by up to
-            // half a window at each abrupt edge) is kept whole.
-            let (a, b) = match commanded {
-                Some(wc) => {
-                    let rev_samples = std::f64::consts::TAU / wc.abs() * fs;
-                    let have = (b - a) as f64;
-                    let revs = (have / rev_samples).round();
-                    let len = (revs * rev_samples).round() as usize;
-                    if revs >= 1.0 && len <= b - a && len >= min_rot {
-                        let a2 = a + (b - a - len) / 2;
-                        (a2, a2 + len)
-                    } else {
-                        (a, b)
-                    }
-                }
-                None => (a, b),
-            };
-            let f = sums.accel(a, b);
-            let (up_axis, tilt) = nearest_axis(f);
-            let up = (tilt <= tol).then_some(up_axis);
-            let measured = sums.gyro(a, b)[j];
-            let usable = commanded.is_some() && up == Some(SignedAxis::new(axis, true));
-            if commanded.is_some() && !usable {
-                findings.push(Finding {
-                    kind: FindingKind::Ambiguous,
-                    start_s: t[a],
-                    end_s: t[b - 1],
-                    message: format!(
-                        "rotation {} about {}: {} up during it, the calibration needs +{} up \
-                         (the tested axis on the vertical table axis); not used",
-                        span(a, b).label(),
-                        ['x', 'y', 'z'][j],
-                        up.map_or("no axis".to_string(), |u| u.to_string()),
-                        ['x', 'y', 'z'][j]
-                    ),
-                });
-            }
-            rotations.push(RotationSegment {
-                span: span(a, b),
-                axis,
-                up,
-                measured_rate_rad_s: measured,
-                commanded_rate_rad_s: commanded,
-                revolutions: measured.abs() * (b - a) as f64 * dt / std::f64::consts::TAU,
-                usable,
-                plateau: None,
-            });
-        } else {
-            if b - a < min_static.min(min_rot) {
-                continue;
-            }
-            findings.push(Finding {
-                kind: FindingKind::Ambiguous,
-                start_s: t[a],
-                end_s: t[b - 1],
-                message: format!(
-                    "steady spell {} at {rate_deg_s:.2} deg/s: neither static (< {} deg/s) nor \
-                     a rotation (≥ {} deg/s); not used",
-                    span(a, b).label(),
-                    opts.static_max_rate_deg_s,
-                    opts.rotation_min_rate_deg_s
-                ),
-            });
-        }
+        k0 = k0.max(runs.classify(a, b));
     }
+    let RunClassifier {
+        mut statics,
+        rotations,
+        findings,
+        ..
+    } = runs;
     if !statics.iter().any(|s| s.role == StaticRole::Position) {
         return Err(SegmentError::NoPositions {
             start_s: t[0],

@@ -157,7 +157,7 @@ impl Gait {
 pub struct LandVehicle {
     origin: LocalOrigin,
     c_vb: Mat3,
-    segs: Vec<SegStart>,
+    pub(super) segs: Vec<SegStart>,
     gait: Option<Gait>,
 }
 
