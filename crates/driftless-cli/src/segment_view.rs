@@ -4,11 +4,11 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use driftless::calib::protocol::ChamberManifest;
 use driftless::calib::segment::{
     SegmentInput, SegmentOptions, Segmentation, SiteConstants, StaticRole, segment_log,
 };
 use driftless::io::{ImuLog, Quantity};
-use driftless::sim::chamber_manifest::ChamberManifest;
 use std::path::Path;
 
 /// Settings of the segmentation (used only without `--manifest`).

@@ -10,10 +10,10 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
+use driftless::calib::protocol::ChamberManifest;
 use driftless::calib::six_position::SixPositionOptions;
 use driftless::io::ImuLog;
 use driftless::io::Quantity;
-use driftless::sim::chamber_manifest::ChamberManifest;
 use driftless::thermal::FitOptions;
 use driftless::thermal::check::{CheckOptions, FindingKind, Impact, ThermalCheck, check_log};
 use driftless::thermal::model_file::ThermalModelFile;

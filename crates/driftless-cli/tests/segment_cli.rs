@@ -63,7 +63,7 @@ fn soak_without_manifest() {
     assert_eq!(temps.len(), 5, "{temps:?}");
     // Against the manifest run without that step: every coefficient within 1σ.
     let text = std::fs::read_to_string(sim.join("manifest.toml")).unwrap();
-    let mut m = driftless::sim::chamber_manifest::ChamberManifest::from_toml_str(&text).unwrap();
+    let mut m = driftless::calib::protocol::ChamberManifest::from_toml_str(&text).unwrap();
     m.segments.retain(|s| s.set_temperature_c != 35.0);
     std::fs::write(dir.join("reduced.toml"), m.to_toml_string().unwrap()).unwrap();
     let w = run_json(

@@ -147,6 +147,7 @@ pub mod eval;
 pub mod experiment;
 pub mod io;
 pub mod nav;
+pub mod numeric;
 pub mod prelude;
 pub mod report;
 pub mod sim;

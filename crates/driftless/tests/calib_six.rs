@@ -6,13 +6,13 @@
 
 use std::time::Instant;
 
+use driftless::calib::protocol::SegmentKind;
 use driftless::calib::six_position::{
     PositionMean, RateMean, SixPositionCalibration, SixPositionError, SixPositionInput,
     SixPositionOptions, TriadEstimate, calibrate, calibrate_accel, calibrate_gyro,
     g_sensitivity_identifiable,
 };
 use driftless::sim::chamber::{BodyAxis, ChamberConfig, ChamberManifest, SignedAxis};
-use driftless::sim::chamber_manifest::SegmentKind;
 use driftless::sim::presets::Preset;
 use driftless::sim::sensor::{IdealImu, OutputKind, SensorConfig, SensorModel, SensorOutput};
 use driftless::sim::temperature::TemperatureProfile;
@@ -100,7 +100,7 @@ fn simulate(ch: &Chamber, cfg: &SensorConfig, seed: u64) -> SensorOutput {
 }
 
 fn run(ch: &Chamber, out: &SensorOutput, opt: &SixPositionOptions) -> SixPositionCalibration {
-    let input = SixPositionInput::from_chamber(&ch.manifest, out, 25.0).expect("input");
+    let input = out.six_position_input(&ch.manifest, 25.0).expect("input");
     assert_eq!(input.positions.len(), 6);
     assert_eq!(input.rates.len(), 6);
     calibrate(&input, opt).expect("calibrate")
@@ -364,7 +364,7 @@ fn clean_input() -> (SixPositionInput, SixPositionOptions) {
     let ch = chamber();
     let cfg = noise_free(Preset::Consumer);
     let out = simulate(&ch, &cfg, 3);
-    let input = SixPositionInput::from_chamber(&ch.manifest, &out, 25.0).expect("input");
+    let input = out.six_position_input(&ch.manifest, 25.0).expect("input");
     (input, SixPositionOptions::from_manifest(&ch.manifest))
 }
 
@@ -563,7 +563,7 @@ fn g_sensitivity_identifiability() {
     assert!(!opt_plus.estimate_g_sensitivity, "+k up only: G off");
     // The same with six positions (each +k twice): refused by name, G on or off.
     let out = simulate(&ch, &noise_free(Preset::Consumer), 1);
-    let mut input = SixPositionInput::from_chamber(&m, &out, 25.0).expect("input");
+    let mut input = out.six_position_input(&m, 25.0).expect("input");
     assert_eq!(input.positions.len(), 3);
     input.positions.extend(input.positions.clone());
     for g in [false, true] {

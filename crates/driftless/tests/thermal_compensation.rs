@@ -108,7 +108,7 @@ fn vehicle_warm_up_residual_thermal_bias_below_five_percent() {
         .expect("model")
         .simulate(&proto.ideal(OutputKind::Rates), &curve, 31)
         .expect("simulate");
-    let drift = SoakDrift::from_sensor_config(&cfg);
+    let drift = SoakDrift::from(&cfg);
     let soak = soak_calibration(
         &proto.manifest,
         chamber.accel.each_ref().map(Vec::as_slice),

@@ -69,9 +69,9 @@
 //! (G left out, the same seeds) is in the history of this file: without G, gyro bias z
 //! carries the rate rows' g·G (0.2 °/s/g on the sensing axis).
 
+use driftless::calib::protocol::SegmentKind;
 use driftless::calib::six_position::SixPositionOptions;
 use driftless::sim::chamber::{ChamberConfig, StepOrder};
-use driftless::sim::chamber_manifest::SegmentKind;
 use driftless::sim::presets::Preset;
 use driftless::sim::sensor::{OutputKind, SensorModel};
 use driftless::thermal::FitOptions;
@@ -384,7 +384,7 @@ fn run(seed: u64, protocol: Protocol) -> Run {
     let fs = proto.manifest.sample_rate_hz;
     let mean_over = |o: &Option<driftless::sim::sensor::SensorOutput>,
                      channel: usize,
-                     segs: &mut dyn Iterator<Item = &driftless::sim::chamber_manifest::Segment>|
+                     segs: &mut dyn Iterator<Item = &driftless::calib::protocol::Segment>|
      -> f64 {
         let Some(o) = o else { return 0.0 };
         let (mut s, mut n) = (0.0, 0usize);
@@ -428,7 +428,7 @@ fn run(seed: u64, protocol: Protocol) -> Run {
     assert!(six.estimate_g_sensitivity, "from_manifest default");
     six.estimate_g_sensitivity = estimate_g;
     // The drift model from the preset's Allan terms (what `driftless allan` reports).
-    let drift = SoakDrift::from_sensor_config(&cfg);
+    let drift = SoakDrift::from(&cfg);
     let t1 = std::time::Instant::now();
     let soak = soak_calibration(
         &proto.manifest,
@@ -630,7 +630,7 @@ fn a_temperature_missing_a_position_is_refused() {
         .simulate(&proto.ideal(OutputKind::Rates), &curve, 1)
         .expect("simulate");
     let six = SixPositionOptions::from_manifest(&proto.manifest);
-    let soak = |manifest: &driftless::sim::chamber_manifest::ChamberManifest, order: usize| {
+    let soak = |manifest: &driftless::calib::protocol::ChamberManifest, order: usize| {
         soak_calibration(
             manifest,
             out.accel.each_ref().map(Vec::as_slice),

@@ -6,9 +6,9 @@
 //! ones. And the gyro g-sensitivity the soak estimates is carried into the compensation
 //! model and removes g·G from the compensated gyro.
 
+use driftless::calib::protocol::SegmentKind;
 use driftless::calib::six_position::SixPositionOptions;
 use driftless::sim::chamber::{ChamberConfig, ChamberProtocol, StepOrder};
-use driftless::sim::chamber_manifest::SegmentKind;
 use driftless::sim::presets::Preset;
 use driftless::sim::sensor::{OutputKind, SensorModel, SensorOutput};
 use driftless::thermal::FitOptions;
@@ -53,7 +53,7 @@ fn simulate(seed: u64, every_noise: bool) -> (ChamberProtocol, SensorOutput, Soa
     if !every_noise {
         cfg = cfg.without_slow_noise();
     }
-    let drift = SoakDrift::from_sensor_config(&cfg);
+    let drift = SoakDrift::from(&cfg);
     let curve = proto.temperature.curve().expect("temperature");
     let out = SensorModel::new(cfg)
         .expect("model")

@@ -112,81 +112,9 @@ pub fn gauss_markov_avar_peak() -> (f64, f64) {
 }
 
 // ---------------------------------------------------------------------------------------
-// Normal distribution helpers (no external crate).
+// Normal distribution helpers: one implementation, in [`crate::numeric::normal`].
 
-/// Complementary error function, |relative error| < 1e-13 (power series for |x| < 2,
-/// continued fraction of Laplace's asymptotic form beyond; Abramowitz & Stegun 7.1.5, 7.1.14).
-pub fn erfc(x: f64) -> f64 {
-    if x.is_nan() {
-        return f64::NAN;
-    }
-    if x < 0.0 {
-        return 2.0 - erfc(-x);
-    }
-    if x < 2.0 {
-        // erf(x) = 2/√π Σ (−1)ⁿ x^{2n+1}/(n!(2n+1))
-        let x2 = x * x;
-        let mut term = x;
-        let mut sum = x;
-        let mut n = 0.0;
-        loop {
-            n += 1.0;
-            term *= -x2 / n;
-            let add = term / (2.0 * n + 1.0);
-            sum += add;
-            if add.abs() <= 1e-17 * sum.abs() || n > 200.0 {
-                break;
-            }
-        }
-        return 1.0 - 2.0 / PI.sqrt() * sum;
-    }
-    if x > 27.0 {
-        return 0.0;
-    }
-    // erfc(x) = e^{−x²}/√π · 1/(x + (1/2)/(x + 1/(x + (3/2)/(x + 2/(x + …)))))
-    let mut f = x;
-    for k in (1..=80).rev() {
-        f = x + (k as f64 / 2.0) / f;
-    }
-    (-x * x).exp() / PI.sqrt() / f
-}
-
-/// Standard normal CDF Φ(x).
-pub fn normal_cdf(x: f64) -> f64 {
-    0.5 * erfc(-x / std::f64::consts::SQRT_2)
-}
-
-/// Standard normal quantile Φ⁻¹(p) (bisection on [`normal_cdf`], |error| < 1e-12).
-pub fn normal_quantile(p: f64) -> f64 {
-    if !(p > 0.0 && p < 1.0) {
-        return if p == 0.0 {
-            f64::NEG_INFINITY
-        } else if p == 1.0 {
-            f64::INFINITY
-        } else {
-            f64::NAN
-        };
-    }
-    // Bisect in the lower half only: near p = 1, Φ(x) rounds to 1 − k·2⁻⁵³ and the
-    // quantile would be lost (7.7e-6 at p = 1 − 1e-12); 1 − p is exact for p ≥ ½
-    // (Sterbenz) and Φ⁻¹(p) = −Φ⁻¹(1 − p).
-    if p > 0.5 {
-        return -normal_quantile(1.0 - p);
-    }
-    let (mut lo, mut hi) = (-40.0f64, 40.0f64);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if normal_cdf(mid) < p {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo < 1e-13 {
-            break;
-        }
-    }
-    0.5 * (lo + hi)
-}
+pub use crate::numeric::normal::{erfc, normal_cdf, normal_quantile};
 
 // ---------------------------------------------------------------------------------------
 // Fit.

@@ -5,60 +5,7 @@
 //!
 //! Matrices are row-major `Vec<f64>` of n × n (or m × n for Jacobians).
 
-/// Cholesky factor L (row-major, lower) of a symmetric positive-definite n × n matrix,
-/// or `None` when it is not numerically positive definite.
-pub fn cholesky(a: &[f64], n: usize) -> Option<Vec<f64>> {
-    let mut l = vec![0.0; n * n];
-    for i in 0..n {
-        for j in 0..=i {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= l[i * n + k] * l[j * n + k];
-            }
-            if i == j {
-                if !(s > 0.0 && s.is_finite()) {
-                    return None;
-                }
-                l[i * n + i] = s.sqrt();
-            } else {
-                l[i * n + j] = s / l[j * n + j];
-            }
-        }
-    }
-    Some(l)
-}
-
-/// Solves L Lᵀ x = b.
-pub fn cholesky_solve(l: &[f64], n: usize, b: &[f64]) -> Vec<f64> {
-    let mut y = b.to_vec();
-    for i in 0..n {
-        for k in 0..i {
-            y[i] -= l[i * n + k] * y[k];
-        }
-        y[i] /= l[i * n + i];
-    }
-    for i in (0..n).rev() {
-        for k in (i + 1)..n {
-            y[i] -= l[k * n + i] * y[k];
-        }
-        y[i] /= l[i * n + i];
-    }
-    y
-}
-
-/// (L Lᵀ)⁻¹.
-pub fn cholesky_inverse(l: &[f64], n: usize) -> Vec<f64> {
-    let mut inv = vec![0.0; n * n];
-    for c in 0..n {
-        let mut e = vec![0.0; n];
-        e[c] = 1.0;
-        let x = cholesky_solve(l, n, &e);
-        for r in 0..n {
-            inv[r * n + c] = x[r];
-        }
-    }
-    inv
-}
+use crate::numeric::{cholesky, cholesky_inverse, cholesky_solve};
 
 /// JᵀJ (n × n) and Jᵀr (n) of an m × n Jacobian and m residuals.
 pub fn normal_equations(j: &[f64], r: &[f64], m: usize, n: usize) -> (Vec<f64>, Vec<f64>) {

@@ -9,6 +9,8 @@
 //! * [`static_detect`]: static-interval detection by moving variance (Tedaldi et al. 2014).
 //! * [`multi_position`]: multi-position accelerometer and gyro calibration without
 //!   fixtures (Tedaldi et al. 2014).
+//! * [`protocol`]: the protocol's axes and positions and its segment manifest (which time
+//!   range holds which test at which set temperature).
 //! * [`quality`]: χ²/dof, warnings and the plausibility verdict of a fit.
 //! * [`segment`]: segmentation of a calibration log from its data (static positions,
 //!   rotations, temperature plateaus) into a segment manifest.
@@ -18,6 +20,7 @@
 pub mod lsq;
 pub mod model_file;
 pub mod multi_position;
+pub mod protocol;
 pub mod quality;
 pub mod segment;
 pub mod six_position;

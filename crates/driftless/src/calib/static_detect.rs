@@ -155,9 +155,7 @@ pub(crate) fn median_dt(time_s: &[f64]) -> Result<f64, CalibError> {
             need_s: 0.0,
         });
     }
-    let mid = d.len() / 2;
-    d.select_nth_unstable_by(mid, f64::total_cmp);
-    let dt = d[mid];
+    let dt = crate::numeric::upper_median(&mut d).unwrap_or(f64::NAN);
     if !(dt > 0.0 && dt.is_finite()) {
         return Err(CalibError::BadInput(format!(
             "time stamps are not increasing (median interval {dt} s)"

@@ -27,6 +27,7 @@ pub mod log {
 pub mod nav;
 mod number;
 pub mod output;
+pub mod probe;
 pub mod text;
 mod timing;
 #[cfg(feature = "autopilot-logs")]

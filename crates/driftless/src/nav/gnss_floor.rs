@@ -138,11 +138,9 @@ fn excess_variance(nu2: &[f64], hph: &[f64], median_ratio: f64) -> f64 {
     (m_nu2 - m_hph).max(0.0)
 }
 
-/// Median of a non-empty sample (upper median for even lengths).
+/// Median of a sample (upper median for even lengths; NaN when empty).
 fn median(x: &[f64]) -> f64 {
-    let mut v = x.to_vec();
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+    crate::numeric::upper_median(&mut x.to_vec()).unwrap_or(f64::NAN)
 }
 
 /// The fixes with each class's floor applied: σ = max(σ_file, floor / k) so that after

@@ -419,13 +419,9 @@ fn channel_rates(stream: &ImuStream, c_bv: Option<&Mat3>) -> [Vec<f64>; 6] {
     out
 }
 
-/// Median of `v` (reorders it); NaN when empty.
+/// Median of `v` (upper median for even lengths; reorders it); NaN when empty.
 fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    let mid = v.len() / 2;
-    *v.select_nth_unstable_by(mid, f64::total_cmp).1
+    crate::numeric::upper_median(v).unwrap_or(f64::NAN)
 }
 
 /// Checks the values of `stream` (module docs). `c_vb` is the mounting rotation the

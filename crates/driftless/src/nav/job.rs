@@ -11,6 +11,7 @@ use crate::eval::SelectedOutage;
 use crate::io::TextOptions;
 use crate::io::nav::GnssFixes;
 use crate::io::nav::kfgins::GnssReadOptions;
+use crate::io::probe::{self, PathKind};
 use crate::nav::config::{ConfigError, KeyError, LoadedConfig};
 use crate::nav::filter::aids::{NhcConfig, StandstillConfig};
 use crate::nav::filter::model::{FilterConfig, ImuNoise};
@@ -115,15 +116,17 @@ fn required(
     match v {
         Some(p) => {
             let p = cfg.path(key, p);
-            match std::fs::metadata(&p) {
+            match PathKind::of(&p) {
                 // A pipe, FIFO or `/dev/stdin` is read once, as a file is.
-                Ok(m) if !m.is_dir() => Ok(p),
-                Ok(_) => Err(located(
+                PathKind::File | PathKind::Other => Ok(p),
+                PathKind::Dir => Err(located(
                     cfg,
                     key,
                     format!("{}: a folder, not a file", p.display()),
                 )),
-                Err(_) => Err(located(cfg, key, format!("{}: no such file", p.display()))),
+                PathKind::Missing => {
+                    Err(located(cfg, key, format!("{}: no such file", p.display())))
+                }
             }
         }
         None => Err(NavJobError::Config(ConfigError {
@@ -145,17 +148,10 @@ pub fn detect_imu_format(format: &str, file: &Path, tag_given: bool) -> ImuForma
         "tagged-csv" => ImuFormat::TaggedCsv,
         "csv" => ImuFormat::Csv,
         _ => {
-            if tag_given || default_tag(file).is_file() {
+            if tag_given || PathKind::of(&default_tag(file)) == PathKind::File {
                 return ImuFormat::TaggedCsv;
             }
-            let head = std::fs::File::open(file).ok().and_then(|f| {
-                use std::io::{BufRead, BufReader, Read};
-                let mut line = String::new();
-                BufReader::new(f.take(64 * 1024))
-                    .read_line(&mut line)
-                    .ok()?;
-                Some(line)
-            });
+            let head = probe::first_line(file, 64 * 1024);
             let header = head.is_some_and(|l| {
                 l.split([',', ' ', '\t', ';'])
                     .map(str::trim)
@@ -287,7 +283,7 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
     let tag = c.imu.tag.as_ref().map(|t| cfg.path("imu.tag", t));
     if c.imu.format == "auto"
         && tag.is_none()
-        && std::fs::metadata(&imu_path).is_ok_and(|m| !m.is_file())
+        && matches!(PathKind::of(&imu_path), PathKind::Dir | PathKind::Other)
     {
         // Detection reads the first line; from a pipe those bytes would be gone for the
         // reader.
@@ -353,7 +349,7 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
         }
         ImuFormat::TaggedCsv => {
             let tag = tag.unwrap_or_else(|| default_tag(&imu_path));
-            if !tag.is_file() {
+            if PathKind::of(&tag) != PathKind::File {
                 return Err(located(
                     cfg,
                     "imu.tag",
@@ -470,6 +466,7 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
     })
 }
 
+/// Upper median of the positive epoch intervals, s (NaN when there are none).
 fn median_interval(imu: &ImuStream) -> f64 {
     let mut d: Vec<f64> = imu
         .epochs
@@ -477,11 +474,7 @@ fn median_interval(imu: &ImuStream) -> f64 {
         .map(|e| e.dt_s)
         .filter(|d| *d > 0.0)
         .collect();
-    if d.is_empty() {
-        return f64::NAN;
-    }
-    d.sort_by(f64::total_cmp);
-    d[d.len() / 2]
+    crate::numeric::upper_median(&mut d).unwrap_or(f64::NAN)
 }
 
 /// `auto:NxL` outages: chosen on the GNSS fixes inside the IMU span (the only reference of

@@ -88,13 +88,13 @@ use driftless_model::linalg::{Mat3, Vec3};
 use driftless_model::units::DEG;
 use serde::{Deserialize, Serialize};
 
-pub use super::chamber_manifest::{
-    BodyAxis, ChamberManifest, MANIFEST_VERSION, Segment, SegmentKind, SignedAxis,
-};
 use super::ideal_imu::{Trajectory, TrajectoryPoint};
 use super::sensor::{IdealImu, OutputKind, ideal_sample};
 use super::sensor_error::{SensorSimError, check_finite, check_pos};
 use super::temperature::{ChamberStep, TemperatureProfile};
+pub use crate::calib::protocol::{
+    BodyAxis, ChamberManifest, MANIFEST_VERSION, Segment, SegmentKind, SignedAxis,
+};
 use crate::nav::attitude::Quat;
 use crate::nav::earth;
 

@@ -16,10 +16,9 @@
 //!   increments ([`sensor_config`]: its configuration, [`sensor_data`]: ideal input and
 //!   simulated output); [`presets`]: named sensor classes.
 //! * [`chamber`]: the thermal-chamber calibration protocol as a trajectory plus a
-//!   segment manifest ([`chamber_manifest`]).
+//!   segment manifest ([`crate::calib::protocol`]).
 
 pub mod chamber;
-pub mod chamber_manifest;
 pub mod gnss;
 pub mod ideal_imu;
 pub mod noise;

@@ -19,15 +19,7 @@
 
 use std::sync::OnceLock;
 
-/// SplitMix64 step: advances `state` and returns a well-mixed 64-bit output.
-#[inline]
-pub fn splitmix64(state: &mut u64) -> u64 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
+pub use crate::numeric::splitmix64;
 
 /// xoshiro256++ generator with uniform and standard-normal variates.
 #[derive(Clone, Debug)]
@@ -274,7 +266,7 @@ mod tests {
                 h[((x + 4.0) / 8.0 * bins as f64) as usize] += 1;
             }
         }
-        let phi = |x: f64| 0.5 * erfc_approx(-x / std::f64::consts::SQRT_2);
+        let phi = crate::numeric::normal_cdf;
         let mut chi2 = 0.0;
         for (k, &c) in h.iter().enumerate() {
             let a = -4.0 + 8.0 * k as f64 / bins as f64;
@@ -284,10 +276,5 @@ mod tests {
         }
         // 39 dof: 99.99 % quantile ≈ 80.
         assert!(chi2 < 80.0, "chi2 = {chi2}");
-    }
-
-    /// erfc with ~1e-12 accuracy for the test (series / continued fraction).
-    fn erfc_approx(x: f64) -> f64 {
-        crate::allan::fit::erfc(x)
     }
 }

@@ -55,7 +55,6 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::chamber::ChamberConfig;
-use super::chamber_manifest::ChamberManifest;
 use super::gnss::{GnssSimConfig, simulate_gnss};
 use super::ideal_imu::{Trajectory, TrajectoryPoint};
 use super::presets::Preset;
@@ -64,6 +63,7 @@ use super::sensor::SensorModel;
 use super::sensor_config::SensorConfig;
 use super::sensor_data::{IdealImu, OutputKind, SensorOutput};
 use super::temperature::TemperatureProfile;
+use crate::calib::protocol::ChamberManifest;
 use crate::io::nav::{GnssFixes, GnssReadOptions, NavSolution};
 use crate::nav::attitude::{Euler, Quat};
 use crate::nav::mechanization::NavState;

@@ -283,3 +283,19 @@ impl SensorConfig {
         }
     }
 }
+
+/// The bias-instability and rate-random-walk terms of a simulated sensor's configuration
+/// (SI), e.g. a preset's, as the slow-drift model of a thermal soak fit.
+impl From<&SensorConfig> for crate::thermal::soak::SoakDrift {
+    fn from(cfg: &SensorConfig) -> crate::thermal::soak::SoakDrift {
+        use crate::thermal::soak::ChannelDrift;
+        let ch = |n: &AxisNoise| ChannelDrift {
+            bias_instability: n.bias_instability,
+            rate_random_walk: n.rate_random_walk,
+        };
+        crate::thermal::soak::SoakDrift {
+            accel: cfg.accel.noise.each_ref().map(ch),
+            gyro: cfg.gyro.noise.each_ref().map(ch),
+        }
+    }
+}

@@ -8,6 +8,8 @@ use serde::{Deserialize, Serialize};
 use super::ideal_imu::{Trajectory, TrajectoryPoint, ideal_increment};
 use super::sensor_config::CHANNEL_NAMES;
 use super::sensor_error::{SensorSimError, check_finite, check_pos};
+use crate::calib::protocol::ChamberManifest;
+use crate::calib::six_position::{SixPositionError, SixPositionInput};
 use crate::io::{Channel, ImuLog, Quantity};
 use crate::nav::mechanization::ImuIncrement;
 
@@ -268,6 +270,35 @@ impl SensorOutput {
                 dvel_m_s: self.accel_at(k).map(|v| v * w),
             })
             .collect()
+    }
+
+    /// The position and rate segments at set temperature `set_temperature_c` of a chamber
+    /// manifest, averaged from a simulated (or recorded, same layout) output: rates are
+    /// used as they are, increments divided by Δt. Samples per segment:
+    /// [`crate::calib::protocol::Segment::sample_range`].
+    pub fn six_position_input(
+        &self,
+        manifest: &ChamberManifest,
+        set_temperature_c: f64,
+    ) -> Result<SixPositionInput, SixPositionError> {
+        let fs = manifest.sample_rate_hz;
+        if !(fs > 0.0 && self.dt_s > 0.0) || ((1.0 / fs) - self.dt_s).abs() > 1e-9 * self.dt_s {
+            return Err(SixPositionError::Invalid(format!(
+                "manifest rate {fs} Hz does not match the output's Δt = {} s",
+                self.dt_s
+            )));
+        }
+        let scale = match self.kind {
+            OutputKind::Rates => 1.0,
+            OutputKind::Increments => 1.0 / self.dt_s,
+        };
+        SixPositionInput::from_manifest_columns(
+            manifest,
+            self.accel.each_ref().map(Vec::as_slice),
+            self.gyro.each_ref().map(Vec::as_slice),
+            scale,
+            set_temperature_c,
+        )
     }
 
     /// A columnar log (`gyro_x` … `acc_z`, `temp`) with a time column, e.g. for

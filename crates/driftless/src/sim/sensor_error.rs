@@ -53,6 +53,12 @@ pub enum SensorSimError {
     Manifest(String),
 }
 
+impl From<crate::calib::protocol::ManifestError> for SensorSimError {
+    fn from(e: crate::calib::protocol::ManifestError) -> SensorSimError {
+        SensorSimError::Manifest(e.0)
+    }
+}
+
 impl SensorSimError {
     /// Shorthand for [`SensorSimError::Invalid`].
     pub fn invalid(what: impl Into<String>, why: impl Into<String>) -> SensorSimError {

@@ -92,11 +92,11 @@
 //!    and the flicker between ± visits averages down.
 
 use super::fit::{FitOptions, ThermalFit, ThermalFitError, fit, fit_correlated};
+use crate::calib::protocol::{ChamberManifest, SegmentKind};
 use crate::calib::six_position::{
     GSensitivityEstimate, SixPositionError, SixPositionInput, SixPositionOptions, TriadEstimate,
     calibrate,
 };
-use crate::sim::chamber_manifest::{ChamberManifest, SegmentKind};
 use driftless_model::linalg::Mat3;
 
 /// Why a soak calibration failed.
@@ -171,19 +171,6 @@ pub struct SoakDrift {
 }
 
 impl SoakDrift {
-    /// The bias-instability and rate-random-walk terms of a simulated sensor's
-    /// configuration (SI), e.g. a preset's.
-    pub fn from_sensor_config(cfg: &crate::sim::sensor_config::SensorConfig) -> SoakDrift {
-        let ch = |n: &crate::sim::sensor_config::AxisNoise| ChannelDrift {
-            bias_instability: n.bias_instability,
-            rate_random_walk: n.rate_random_walk,
-        };
-        SoakDrift {
-            accel: cfg.accel.noise.each_ref().map(ch),
-            gyro: cfg.gyro.noise.each_ref().map(ch),
-        }
-    }
-
     /// The bias-instability and rate-random-walk terms of a noise-model file
     /// (`driftless allan --save-model`): its angular-rate channels are gyro x, y, z and
     /// its specific-force channels accel x, y, z, in file order (SI units, so the soak's

@@ -1,4 +1,4 @@
-//! Student-t and normal quantiles for the confidence intervals of [`super::fit`](mod@super::fit).
+//! Student-t quantiles (and the normal quantile, re-exported from [`crate::numeric`]) for the confidence intervals of [`super::fit`](mod@super::fit).
 //!
 //! The Student-t distribution function is evaluated through the regularized incomplete
 //! beta function (Abramowitz & Stegun 26.7.1, 26.5.8 continued fraction, evaluated with
@@ -11,7 +11,8 @@
 //! and inverted by safeguarded bisection (monotone, so ≤ 200 halvings reach machine
 //! precision; the quantile is used only as a coverage factor, computed once per fit).
 
-use crate::allan::ci::chi2::{ln_gamma, normal_quantile as acklam};
+use crate::allan::ci::chi2::ln_gamma;
+pub use crate::numeric::normal_quantile;
 
 /// Continued fraction of the incomplete beta function (NR `betacf`, modified Lentz).
 fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
@@ -85,7 +86,7 @@ pub fn student_t_quantile(p: f64, dof: f64) -> f64 {
     }
     // Work on the upper half and reflect (the distribution is symmetric).
     let (q, sign) = if p > 0.5 { (p, 1.0) } else { (1.0 - p, -1.0) };
-    let mut hi = acklam(q).max(1.0);
+    let mut hi = normal_quantile(q).max(1.0);
     let mut guard = 0;
     while student_t_cdf(hi, dof) < q && guard < 2000 {
         hi *= 2.0;
@@ -104,15 +105,6 @@ pub fn student_t_quantile(p: f64, dof: f64) -> f64 {
         }
     }
     sign * 0.5 * (lo + hi)
-}
-
-/// Standard normal quantile z(p) (Acklam's rational approximation, relative error
-/// < 1.2e-9), for 0 < p < 1 (NaN otherwise).
-pub fn normal_quantile(p: f64) -> f64 {
-    if !(p > 0.0 && p < 1.0) {
-        return f64::NAN;
-    }
-    acklam(p)
 }
 
 /// Floor of |C| and |D| in the modified Lentz method.

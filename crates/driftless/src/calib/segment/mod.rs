@@ -2,7 +2,7 @@
 //! axis that points up, rate-table rotations (axis, rate, sense, revolutions) and
 //! temperature plateaus (temperature, settled or not, dwell), with findings (missing
 //! positions, unsettled plateaus, ambiguous segments) named by their time span. A
-//! [`Segmentation`] becomes the segment manifest of [`crate::sim::chamber_manifest`]
+//! [`Segmentation`] becomes the segment manifest of [`super::protocol`]
 //! ([`Segmentation::manifest_of`]), so the six-position and soak calibrations
 //! ([`crate::calib::six_position`], [`crate::thermal::soak`]) run on it unchanged.
 //!
@@ -74,11 +74,17 @@
 use driftless_model::linalg::{Vec3, norm};
 use serde::Serialize;
 
-use super::static_detect::{StaticDetectOptions, variance_profile};
-use crate::nav::earth;
-use crate::sim::chamber_manifest::{
+use super::protocol::{
     BodyAxis, ChamberManifest, MANIFEST_VERSION, Segment, SegmentKind, SignedAxis,
 };
+use super::static_detect::{StaticDetectOptions, variance_profile};
+use crate::nav::earth;
+
+mod manifest;
+mod plateau;
+mod runs;
+use plateau::*;
+use runs::RunClassifier;
 
 /// Settings of [`segment_log`] (module docs for each threshold).
 #[derive(Clone, Debug, PartialEq)]
@@ -528,13 +534,9 @@ fn check_input(inp: &SegmentInput) -> Result<f64, SegmentError> {
     Ok(1.0 / dt)
 }
 
+/// Upper median of `v`; 0 when empty.
 fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    let mid = v.len() / 2;
-    v.select_nth_unstable_by(mid, f64::total_cmp);
-    v[mid]
+    crate::numeric::upper_median(&mut v).unwrap_or(0.0)
 }
 
 /// Prefix sums of the columns, for means over sample ranges.
@@ -633,14 +635,21 @@ pub fn segment_log(
         .map(|k| va.sigma[k] < th_a && vg.sigma[k] < th_g)
         .collect();
     let sums = Sums::new(inp.accel_m_s2, inp.gyro_rad_s, inp.temperature_c);
-    let mut findings = Vec::new();
-    let mut statics = Vec::new();
-    let mut rotations = Vec::new();
-    let mut inferred_rates: Vec<f64> = Vec::new();
-    let min_static = ((opts.min_static_s * fs).round() as usize).max(2);
-    let min_rot = ((opts.min_rotation_s * fs).round() as usize).max(2);
-    let trim = (opts.trim_s * fs).round() as usize;
-    let tol = opts.orientation_tolerance_deg;
+    let mut runs = RunClassifier {
+        inp,
+        opts,
+        fs,
+        sums: &sums,
+        min_static: ((opts.min_static_s * fs).round() as usize).max(2),
+        min_rot: ((opts.min_rotation_s * fs).round() as usize).max(2),
+        trim: (opts.trim_s * fs).round() as usize,
+        tol: opts.orientation_tolerance_deg,
+        findings: Vec::new(),
+        statics: Vec::new(),
+        rotations: Vec::new(),
+        inferred_rates: Vec::new(),
+    };
+    let tol = runs.tol;
     let mut k0 = 0;
     while k0 < n {
         if !quiet[k0] {
@@ -653,189 +662,17 @@ pub fn segment_log(
         }
         let (a, b) = (k0, k1);
         k0 = k1;
-        if b - a < min_static.min(min_rot) {
+        if b - a < runs.min_static.min(runs.min_rot) {
             continue;
         }
-        let (a, b) = extend_run(inp, a, b, (opts.window_s * fs).round() as usize);
-        k0 = k0.max(b);
-        let w = sums.gyro(a, b);
-        let rate_deg_s = norm(w).to_degrees();
-        if rate_deg_s < opts.static_max_rate_deg_s {
-            if b - a < min_static {
-                continue;
-            }
-            let (a, b) = if b - a >= 2 * trim + min_static {
-                (a + trim, b - trim)
-            } else {
-                (a, b)
-            };
-            let f = sums.accel(a, b);
-            let (axis, tilt) = nearest_axis(f);
-            let (up, role) = if tilt <= tol {
-                (Some(axis), StaticRole::Position)
-            } else {
-                if tilt <= 2.0 * tol {
-                    findings.push(Finding {
-                        kind: FindingKind::Ambiguous,
-                        start_s: t[a],
-                        end_s: t[b - 1],
-                        message: format!(
-                            "static {}: {tilt:.1}° from {axis} up, beyond the {tol}° \
-                             orientation tolerance; not used (re-level the fixture or raise the \
-                             tolerance)",
-                            span(a, b).label()
-                        ),
-                    });
-                }
-                (None, StaticRole::Other)
-            };
-            statics.push(StaticSegment {
-                span: span(a, b),
-                up,
-                tilt_deg: tilt,
-                mean_accel_m_s2: f,
-                role,
-                position_tail: None,
-                plateau: None,
-            });
-        } else if rate_deg_s >= opts.rotation_min_rate_deg_s {
-            if b - a < min_rot {
-                continue;
-            }
-            let j = (0..3)
-                .max_by(|&x, &y| w[x].abs().total_cmp(&w[y].abs()))
-                .unwrap_or(2);
-            let off = (0..3)
-                .filter(|&i| i != j)
-                .map(|i| w[i].abs())
-                .fold(0.0, f64::max);
-            let label = span(a, b).label();
-            if off > 0.05 * w[j].abs() {
-                findings.push(Finding {
-                    kind: FindingKind::Ambiguous,
-                    start_s: t[a],
-                    end_s: t[b - 1],
-                    message: format!(
-                        "rotation {label} at {rate_deg_s:.2} deg/s is not about one body axis \
-                         (cross-axis rate {:.1} % of it); not used (mount the IMU with an axis \
-                         on the table axis)",
-                        100.0 * off / w[j].abs()
-                    ),
-                });
-                continue;
-            }
-            let axis = BodyAxis::ALL[j];
-            let measured = w[j];
-            let commanded_abs_deg = match opts.table_rate_deg_s {
-                Some(r) => r,
-                None => {
-                    let r = (measured.abs().to_degrees() / opts.rate_round_deg_s).round()
-                        * opts.rate_round_deg_s;
-                    if r > 0.0 && !inferred_rates.contains(&r) {
-                        inferred_rates.push(r);
-                        findings.push(Finding {
-                            kind: FindingKind::RateInferred { rate_deg_s: r },
-                            start_s: t[a],
-                            end_s: t[b - 1],
-                            message: format!(
-                                "rotation {label}: table rate taken as {r} deg/s (measured \
-                                 {:.3} deg/s rounded to {} deg/s); state it with the table \
-                                 rate option if it differs",
-                                measured.abs().to_degrees(),
-                                opts.rate_round_deg_s
-                            ),
-                        });
-                    }
-                    r
-                }
-            };
-            let rel = (measured.abs().to_degrees() - commanded_abs_deg).abs() / commanded_abs_deg;
-            let commanded = if commanded_abs_deg > 0.0 && rel <= opts.rate_tolerance {
-                Some(commanded_abs_deg.to_radians() * measured.signum())
-            } else {
-                findings.push(Finding {
-                    kind: FindingKind::Ambiguous,
-                    start_s: t[a],
-                    end_s: t[b - 1],
-                    message: format!(
-                        "rotation {label} about {}: measured {:.3} deg/s differs from the table \
-                         rate {commanded_abs_deg} deg/s by {:.1} % (> {:.1} %); not used (state \
-                         the table rate, or raise the rate tolerance)",
-                        ['x', 'y', 'z'][j],
-                        measured.to_degrees(),
-                        100.0 * rel,
-                        100.0 * opts.rate_tolerance
-                    ),
-                });
-                None
-            };
-            // Whole revolutions of the commanded rate about the centre when the run is
-            // longer (ramp tails cut symmetrically); a run shorter than its nearest whole
-            // number of revolutions (the centred variance window shortens a run by up to
-            // half a window at each abrupt edge) is kept whole.
-            let (a, b) = match commanded {
-                Some(wc) => {
-                    let rev_samples = std::f64::consts::TAU / wc.abs() * fs;
-                    let have = (b - a) as f64;
-                    let revs = (have / rev_samples).round();
-                    let len = (revs * rev_samples).round() as usize;
-                    if revs >= 1.0 && len <= b - a && len >= min_rot {
-                        let a2 = a + (b - a - len) / 2;
-                        (a2, a2 + len)
-                    } else {
-                        (a, b)
-                    }
-                }
-                None => (a, b),
-            };
-            let f = sums.accel(a, b);
-            let (up_axis, tilt) = nearest_axis(f);
-            let up = (tilt <= tol).then_some(up_axis);
-            let measured = sums.gyro(a, b)[j];
-            let usable = commanded.is_some() && up == Some(SignedAxis::new(axis, true));
-            if commanded.is_some() && !usable {
-                findings.push(Finding {
-                    kind: FindingKind::Ambiguous,
-                    start_s: t[a],
-                    end_s: t[b - 1],
-                    message: format!(
-                        "rotation {} about {}: {} up during it, the calibration needs +{} up \
-                         (the tested axis on the vertical table axis); not used",
-                        span(a, b).label(),
-                        ['x', 'y', 'z'][j],
-                        up.map_or("no axis".to_string(), |u| u.to_string()),
-                        ['x', 'y', 'z'][j]
-                    ),
-                });
-            }
-            rotations.push(RotationSegment {
-                span: span(a, b),
-                axis,
-                up,
-                measured_rate_rad_s: measured,
-                commanded_rate_rad_s: commanded,
-                revolutions: measured.abs() * (b - a) as f64 * dt / std::f64::consts::TAU,
-                usable,
-                plateau: None,
-            });
-        } else {
-            if b - a < min_static.min(min_rot) {
-                continue;
-            }
-            findings.push(Finding {
-                kind: FindingKind::Ambiguous,
-                start_s: t[a],
-                end_s: t[b - 1],
-                message: format!(
-                    "steady spell {} at {rate_deg_s:.2} deg/s: neither static (< {} deg/s) nor \
-                     a rotation (≥ {} deg/s); not used",
-                    span(a, b).label(),
-                    opts.static_max_rate_deg_s,
-                    opts.rotation_min_rate_deg_s
-                ),
-            });
-        }
+        k0 = k0.max(runs.classify(a, b));
     }
+    let RunClassifier {
+        mut statics,
+        rotations,
+        findings,
+        ..
+    } = runs;
     if !statics.iter().any(|s| s.role == StaticRole::Position) {
         return Err(SegmentError::NoPositions {
             start_s: t[0],
@@ -943,402 +780,6 @@ fn mark_soaks(statics: &mut [StaticSegment], rotations: &[RotationSegment]) {
     }
 }
 
-/// Sample ranges of the temperature plateaus (module docs).
-fn plateau_spans(inp: &SegmentInput, opts: &SegmentOptions, fs: f64) -> Vec<(usize, usize)> {
-    let n = inp.time_s.len();
-    let Some(temp) = inp.temperature_c else {
-        return vec![(0, n)];
-    };
-    // One value per second.
-    let block = (fs.round() as usize).max(1);
-    let nb = n.div_ceil(block);
-    let tb: Vec<f64> = (0..nb)
-        .map(|i| {
-            let (lo, hi) = (i * block, ((i + 1) * block).min(n));
-            temp[lo..hi].iter().sum::<f64>() / (hi - lo) as f64
-        })
-        .collect();
-    let bs = block as f64 / fs;
-    let h = ((0.5 * opts.temperature_window_s / bs).round() as usize).max(1);
-    let mut pre = vec![0.0; nb + 1];
-    for i in 0..nb {
-        pre[i + 1] = pre[i] + tb[i];
-    }
-    let smooth: Vec<f64> = (0..nb)
-        .map(|i| {
-            let (lo, hi) = (i.saturating_sub(h), (i + h + 1).min(nb));
-            (pre[hi] - pre[lo]) / (hi - lo) as f64
-        })
-        .collect();
-    let limit = opts.moving_rate_c_per_min / 60.0;
-    let moving: Vec<bool> = (0..nb)
-        .map(|i| {
-            let (lo, hi) = (i.saturating_sub(h), (i + h).min(nb - 1));
-            hi > lo && ((smooth[hi] - smooth[lo]) / ((hi - lo) as f64 * bs)).abs() > limit
-        })
-        .collect();
-    // Starts of moving runs, gaps shorter than min_plateau_s closed.
-    let gap = ((opts.min_plateau_s / bs).round() as usize).max(1);
-    let mut starts = Vec::new();
-    let mut last_moving: Option<usize> = None;
-    for (i, &m) in moving.iter().enumerate() {
-        if m {
-            if last_moving.is_none_or(|l| i - l > gap) {
-                starts.push(i);
-            }
-            last_moving = Some(i);
-        }
-    }
-    // The smoothed rate flags a change up to a window early: the cut is the first
-    // second whose temperature has left the level before the flag by half the settled
-    // band.
-    let mut cuts: Vec<usize> = Vec::with_capacity(starts.len());
-    for (r, &i0) in starts.iter().enumerate() {
-        let lo = i0.saturating_sub(2 * h);
-        let level = tb[lo..=i0].iter().sum::<f64>() / (i0 - lo + 1) as f64;
-        let stop = starts.get(r + 1).copied().unwrap_or(nb);
-        let i = (i0..stop)
-            .find(|&i| (tb[i] - level).abs() > 0.5 * opts.settled_band_c)
-            .unwrap_or(i0);
-        let k = (i * block).min(n);
-        if k > 0 {
-            cuts.push(k);
-        }
-    }
-    cuts.dedup();
-    let mut out = Vec::new();
-    let mut a = 0;
-    for c in cuts {
-        if c > a {
-            out.push((a, c));
-            a = c;
-        }
-    }
-    out.push((a, n));
-    out
-}
-
-fn assign_plateaus(
-    seg: &mut Segmentation,
-    inp: &SegmentInput,
-    spans: &[(usize, usize)],
-    opts: &SegmentOptions,
-    span: &dyn Fn(usize, usize) -> Span,
-    sums: &Sums,
-) {
-    let which = |sp: Span| -> Option<usize> {
-        let mid = (sp.start + sp.end) / 2;
-        spans.iter().position(|&(a, b)| a <= mid && mid < b)
-    };
-    for s in &mut seg.statics {
-        s.plateau = s.position_span().or(Some(s.span)).and_then(which);
-    }
-    for r in &mut seg.rotations {
-        r.plateau = which(r.span);
-    }
-    for (p, &(a, b)) in spans.iter().enumerate() {
-        let mut positions = [0usize; 6];
-        let mut rot = [[0usize; 2]; 3];
-        // Calibration segments of the plateau: (start, end) samples.
-        let mut cal: Vec<(usize, usize)> = Vec::new();
-        for s in seg.statics.iter().filter(|s| s.plateau == Some(p)) {
-            if let (Some(sp), Some(up)) = (s.position_span(), s.up) {
-                if let Some(i) = SignedAxis::POSITIONS.iter().position(|&q| q == up) {
-                    positions[i] += 1;
-                }
-                cal.push((sp.start, sp.end));
-            }
-        }
-        for r in seg
-            .rotations
-            .iter()
-            .filter(|r| r.plateau == Some(p) && r.usable)
-        {
-            let pos = r.commanded_rate_rad_s.is_some_and(|w| w > 0.0);
-            rot[r.axis.index()][usize::from(!pos)] += 1;
-            cal.push((r.span.start, r.span.end));
-        }
-        let (temperature_c, spread_c) = match inp.temperature_c {
-            None => (inp.nominal_temperature_c, 0.0),
-            Some(temp) => {
-                let ranges: Vec<(usize, usize)> = if cal.is_empty() {
-                    vec![(a, b)]
-                } else {
-                    cal.clone()
-                };
-                let (mut sw, mut swt) = (0.0, 0.0);
-                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-                for &(x, y) in &ranges {
-                    let m = (y - x) as f64;
-                    sw += m;
-                    swt += m * sums.mean(x, y, 6);
-                    // Spread of the segment means over 1-s pieces (smoothed).
-                    let piece = (seg.sample_rate_hz.round() as usize).max(1);
-                    let mut k = x;
-                    while k < y {
-                        let e = (k + piece).min(y);
-                        let v = temp[k..e].iter().sum::<f64>() / (e - k) as f64;
-                        lo = lo.min(v);
-                        hi = hi.max(v);
-                        k = e;
-                    }
-                }
-                (swt / sw, (hi - lo).max(0.0))
-            }
-        };
-        let settled = spread_c <= opts.settled_band_c;
-        let sp = span(a, b);
-        let plateau = TemperaturePlateau {
-            span: sp,
-            temperature_c,
-            spread_c,
-            settled,
-            dwell_s: sp.end_s - sp.start_s,
-            positions,
-            rotations: rot,
-        };
-        if plateau.has_positions() {
-            let label = format!("plateau {p} ({:.2} °C, {})", temperature_c, sp.label());
-            for (i, &c) in positions.iter().enumerate() {
-                if c == 0 {
-                    let up = SignedAxis::POSITIONS[i];
-                    seg.findings.push(Finding {
-                        kind: FindingKind::MissingPosition { up, plateau: p },
-                        start_s: sp.start_s,
-                        end_s: sp.end_s,
-                        message: format!(
-                            "{label}: no static position with {up} up; this plateau cannot be \
-                             calibrated (repeat the position, or leave the plateau out)"
-                        ),
-                    });
-                }
-            }
-            for axis in BodyAxis::ALL {
-                for (s, positive) in [(0, true), (1, false)] {
-                    if rot[axis.index()][s] == 0 {
-                        seg.findings.push(Finding {
-                            kind: FindingKind::MissingRotation {
-                                axis,
-                                positive,
-                                plateau: p,
-                            },
-                            start_s: sp.start_s,
-                            end_s: sp.end_s,
-                            message: format!(
-                                "{label}: no usable rotation about {}{} (ω {} 0 with +{} up); \
-                                 the gyro scale of that axis is not observable here",
-                                if positive { '+' } else { '-' },
-                                ['x', 'y', 'z'][axis.index()],
-                                if positive { '>' } else { '<' },
-                                ['x', 'y', 'z'][axis.index()]
-                            ),
-                        });
-                    }
-                }
-            }
-            if !settled {
-                seg.findings.push(Finding {
-                    kind: FindingKind::UnsettledPlateau {
-                        plateau: p,
-                        spread_c,
-                    },
-                    start_s: sp.start_s,
-                    end_s: sp.end_s,
-                    message: format!(
-                        "{label}: the temperature spans {spread_c:.3} °C over its positions and \
-                         rotations (> {} °C): not settled (soak longer, or raise the settled band)",
-                        opts.settled_band_c
-                    ),
-                });
-            }
-        }
-        seg.plateaus.push(plateau);
-    }
-}
-
-impl Segmentation {
-    /// Indices of the plateaus with static positions (the temperature steps).
-    pub fn steps(&self) -> Vec<usize> {
-        (0..self.plateaus.len())
-            .filter(|&p| self.plateaus[p].has_positions())
-            .collect()
-    }
-
-    /// The findings about plateau `p` (missing positions or rotations, unsettled).
-    pub fn findings_of(&self, p: usize) -> Vec<&Finding> {
-        self.findings
-            .iter()
-            .filter(|f| match f.kind {
-                FindingKind::MissingPosition { plateau, .. }
-                | FindingKind::MissingRotation { plateau, .. }
-                | FindingKind::UnsettledPlateau { plateau, .. } => plateau == p,
-                _ => false,
-            })
-            .collect()
-    }
-
-    /// The segment manifest of the plateaus `plateaus` (time axis: sample k at k/f_s,
-    /// as a manifest's), each a temperature step at its temperature rounded to 1 m°C:
-    /// its static positions and usable rotations in time order (no soak or move
-    /// segments; the calibrations read only these). The site constants are `site`'s.
-    pub fn manifest_of(
-        &self,
-        plateaus: &[usize],
-        site: &SiteConstants,
-    ) -> Result<ChamberManifest, SegmentError> {
-        let site_ok = site.latitude_deg.abs() < 90.0
-            && site.longitude_deg.is_finite()
-            && site.height_m.is_finite()
-            && site.gravity_m_s2.is_none_or(|g| (9.7..=9.9).contains(&g));
-        if !site_ok {
-            return Err(SegmentError::BadInput(format!(
-                "site {site:?}: latitude within ±90°, finite longitude and height, gravity \
-                 9.7–9.9 m/s²"
-            )));
-        }
-        let fs = self.sample_rate_hz;
-        let time = |k: usize| k as f64 / fs;
-        let mut segments: Vec<Segment> = Vec::new();
-        for &p in plateaus {
-            let Some(pl) = self.plateaus.get(p) else {
-                return Err(SegmentError::BadInput(format!(
-                    "plateau {p}: the segmentation has {}",
-                    self.plateaus.len()
-                )));
-            };
-            let set_c = (pl.temperature_c * 1000.0).round() / 1000.0;
-            let mut parts: Vec<(usize, usize, SegmentKind)> = Vec::new();
-            for s in self.statics.iter().filter(|s| s.plateau == Some(p)) {
-                if let (Some(sp), Some(up)) = (s.position_span(), s.up) {
-                    parts.push((sp.start, sp.end, SegmentKind::Position { up }));
-                }
-            }
-            for r in self
-                .rotations
-                .iter()
-                .filter(|r| r.plateau == Some(p) && r.usable)
-            {
-                if let Some(w) = r.commanded_rate_rad_s {
-                    parts.push((
-                        r.span.start,
-                        r.span.end,
-                        SegmentKind::Rate {
-                            axis: r.axis,
-                            rate_rad_s: w,
-                        },
-                    ));
-                }
-            }
-            parts.sort_by_key(|x| x.0);
-            segments.extend(parts.into_iter().map(|(a, b, kind)| Segment {
-                start_s: time(a),
-                end_s: time(b),
-                set_temperature_c: set_c,
-                kind,
-            }));
-        }
-        let lat = site.latitude_deg.to_radians();
-        Ok(ChamberManifest {
-            format_version: MANIFEST_VERSION,
-            sample_rate_hz: fs,
-            latitude_deg: site.latitude_deg,
-            longitude_deg: site.longitude_deg,
-            height_m: site.height_m,
-            gravity_m_s2: site
-                .gravity_m_s2
-                .unwrap_or_else(|| earth::normal_gravity_m_s2(lat, site.height_m)),
-            earth_rate_rad_s: earth::OMEGA_IE,
-            lag_tau_s: 0.0,
-            duration_s: time(self.n_samples),
-            segments,
-        })
-    }
-
-    /// The manifest of every complete step (all six positions): the input of a soak
-    /// calibration. The incomplete steps left out are named in the returned findings
-    /// (their missing positions); an error when no step is complete.
-    pub fn soak_manifest(
-        &self,
-        site: &SiteConstants,
-    ) -> Result<(ChamberManifest, Vec<&Finding>), SegmentError> {
-        let steps = self.steps();
-        let (complete, left): (Vec<usize>, Vec<usize>) =
-            steps.iter().partition(|&&p| self.plateaus[p].complete());
-        if complete.is_empty() {
-            return Err(SegmentError::Incomplete(self.incomplete_message(&left)));
-        }
-        let dropped = left
-            .iter()
-            .flat_map(|&p| self.findings_of(p))
-            .filter(|f| matches!(f.kind, FindingKind::MissingPosition { .. }))
-            .collect();
-        Ok((self.manifest_of(&complete, site)?, dropped))
-    }
-
-    /// The manifest of the one step to calibrate at room temperature: the only step, or
-    /// the one whose temperature is nearest `temperature_c`. An incomplete step is an
-    /// error naming its missing positions and time span.
-    pub fn six_position_manifest(
-        &self,
-        temperature_c: Option<f64>,
-        site: &SiteConstants,
-    ) -> Result<(ChamberManifest, usize), SegmentError> {
-        let steps = self.steps();
-        let p = match (temperature_c, steps.as_slice()) {
-            (_, []) => {
-                return Err(SegmentError::Incomplete(
-                    "no plateau holds a static position".into(),
-                ));
-            }
-            (None, [p]) => *p,
-            (None, _) => {
-                let list: Vec<String> = steps
-                    .iter()
-                    .map(|&p| {
-                        format!(
-                            "{:.2} °C ({})",
-                            self.plateaus[p].temperature_c,
-                            self.plateaus[p].span.label()
-                        )
-                    })
-                    .collect();
-                return Err(SegmentError::Incomplete(format!(
-                    "{} temperature plateaus with positions: {}; choose one by its temperature",
-                    steps.len(),
-                    list.join(", ")
-                )));
-            }
-            (Some(t), _) => steps
-                .iter()
-                .copied()
-                .min_by(|&a, &b| {
-                    (self.plateaus[a].temperature_c - t)
-                        .abs()
-                        .total_cmp(&(self.plateaus[b].temperature_c - t).abs())
-                })
-                .unwrap_or(steps[0]),
-        };
-        if !self.plateaus[p].complete() {
-            return Err(SegmentError::Incomplete(self.incomplete_message(&[p])));
-        }
-        Ok((self.manifest_of(&[p], site)?, p))
-    }
-
-    fn incomplete_message(&self, plateaus: &[usize]) -> String {
-        let lines: Vec<String> = plateaus
-            .iter()
-            .flat_map(|&p| self.findings_of(p))
-            .filter(|f| matches!(f.kind, FindingKind::MissingPosition { .. }))
-            .map(|f| f.message.clone())
-            .collect();
-        if lines.is_empty() {
-            "no temperature plateau has all six static positions".into()
-        } else {
-            lines.join("; ")
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1355,7 +796,7 @@ mod tests {
                 t.push(t.len() as f64 / fs);
                 let sign = if motion && i % 2 == 0 { -1.0 } else { 1.0 };
                 for j in 0..3 {
-                    let e = crate::sim::rng::splitmix64(&mut seed) as f64 / u64::MAX as f64 - 0.5;
+                    let e = crate::numeric::splitmix64(&mut seed) as f64 / u64::MAX as f64 - 0.5;
                     a[j].push(sign * f[j] + 1e-3 * e);
                     g[j].push(sign * w[j] + 1e-4 * e);
                 }

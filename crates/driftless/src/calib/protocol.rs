@@ -1,4 +1,5 @@
-//! Segment manifest of the thermal-chamber protocol ([`super::chamber`]): which time
+//! Segment manifest of a calibration protocol (the thermal-chamber protocol
+//! [`crate::sim::chamber`] writes one; [`super::segment`] finds one in a log): which time
 //! range holds which test (soak, a static position with a given axis up, a rate-table
 //! rotation, a transition) at which set temperature, with the site constants a
 //! calibration needs (exact local gravity, Earth rate). Serialises to TOML as a flat list
@@ -12,7 +13,10 @@ use std::str::FromStr;
 use driftless_model::linalg::{Mat3, Vec3};
 use serde::{Deserialize, Serialize};
 
-use super::sensor_error::SensorSimError;
+/// A manifest could not be written or read as TOML.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("chamber manifest: {0}")]
+pub struct ManifestError(pub String);
 
 /// Manifest format version.
 pub const MANIFEST_VERSION: u32 = 1;
@@ -321,13 +325,13 @@ pub struct ChamberManifest {
 
 impl ChamberManifest {
     /// TOML text.
-    pub fn to_toml_string(&self) -> Result<String, SensorSimError> {
-        toml::to_string(self).map_err(|e| SensorSimError::Manifest(e.to_string()))
+    pub fn to_toml_string(&self) -> Result<String, ManifestError> {
+        toml::to_string(self).map_err(|e| ManifestError(e.to_string()))
     }
 
     /// Parse TOML text.
-    pub fn from_toml_str(s: &str) -> Result<ChamberManifest, SensorSimError> {
-        toml::from_str(s).map_err(|e| SensorSimError::Manifest(e.to_string()))
+    pub fn from_toml_str(s: &str) -> Result<ChamberManifest, ManifestError> {
+        toml::from_str(s).map_err(|e| ManifestError(e.to_string()))
     }
 
     /// The distinct set temperatures in protocol order, °C.
