@@ -24,6 +24,7 @@ pub mod log;
 pub mod nav;
 mod number;
 pub mod output;
+pub mod sim_writer;
 pub mod text;
 mod timing;
 #[cfg(feature = "autopilot-logs")]
