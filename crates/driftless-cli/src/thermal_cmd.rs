@@ -402,6 +402,21 @@ fn soak(s: SoakArgs) -> Result<()> {
         )
         .with_context(|| format!("writing {}", p.display()))?;
     }
+    if s.json {
+        return print_soak_json(&s, soak, id, segmentation, secs);
+    }
+    print_soak_human(&s, soak, secs);
+    Ok(())
+}
+
+/// The `--json` document of a soak calibration.
+fn print_soak_json(
+    s: &SoakArgs,
+    soak: &driftless::thermal::soak::SoakCalibration,
+    id: u64,
+    segmentation: Option<serde_json::Value>,
+    secs: f64,
+) -> Result<()> {
     let g_json = |g: &driftless::calib::six_position::GSensitivityEstimate| {
         serde_json::json!({
             "matrix": g.matrix_raw_per_m_s2.0,
@@ -409,46 +424,49 @@ fn soak(s: SoakArgs) -> Result<()> {
         })
     };
     let g_mean = soak.gyro_g_sensitivity_mean();
-    if s.json {
-        let g_steps: Vec<Option<serde_json::Value>> = soak
-            .gyro_g_sensitivity
-            .iter()
-            .map(|g| g.as_ref().map(g_json))
-            .collect();
-        let g_mean = g_mean.as_ref().map(g_json);
-        let series: Vec<serde_json::Value> = soak
-            .series
-            .iter()
-            .map(|x| {
-                serde_json::json!({
-                    "triad": x.triad, "quantity": x.quantity, "axis": (["x", "y", "z"][x.axis]),
-                    "coefficients": x.fit.coeffs, "std_errors": x.fit.std_errors,
-                    "residual_rms": x.fit.residual_rms, "chi2_per_dof": x.fit.chi2_per_dof,
-                    // √(χ²/dof) of the points against their σ, and the factor applied
-                    // to the σ (≥ 1: the bands follow the scatter seen)
-                    "scatter_ratio": x.fit.scatter_ratio, "sigma_scale": x.fit.sigma_scale,
-                })
+    let g_steps: Vec<Option<serde_json::Value>> = soak
+        .gyro_g_sensitivity
+        .iter()
+        .map(|g| g.as_ref().map(g_json))
+        .collect();
+    let g_mean = g_mean.as_ref().map(g_json);
+    let series: Vec<serde_json::Value> = soak
+        .series
+        .iter()
+        .map(|x| {
+            serde_json::json!({
+                "triad": x.triad, "quantity": x.quantity, "axis": (["x", "y", "z"][x.axis]),
+                "coefficients": x.fit.coeffs, "std_errors": x.fit.std_errors,
+                "residual_rms": x.fit.residual_rms, "chi2_per_dof": x.fit.chi2_per_dof,
+                // √(χ²/dof) of the points against their σ, and the factor applied
+                // to the σ (≥ 1: the bands follow the scatter seen)
+                "scatter_ratio": x.fit.scatter_ratio, "sigma_scale": x.fit.sigma_scale,
             })
-            .collect();
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::json!({
-                "temperatures_c": soak.temperatures_c,
-                "t_ref_c": s.t_ref,
-                "order": s.order,
-                "model_id": id,
-                "series": series,
-                // per step (order of temperatures_c), raw gyro units per m/s²; null when
-                // not estimated
-                "gyro_g_sensitivity": g_steps,
-                "gyro_g_sensitivity_mean": g_mean,
-                // the log's own segmentation when there was no manifest
-                "segmentation": segmentation,
-                "seconds": secs,
-            }))?
-        );
-        return Ok(());
-    }
+        })
+        .collect();
+    outln!(
+        "{}",
+        serde_json::to_string_pretty(&serde_json::json!({
+            "temperatures_c": soak.temperatures_c,
+            "t_ref_c": s.t_ref,
+            "order": s.order,
+            "model_id": id,
+            "series": series,
+            // per step (order of temperatures_c), raw gyro units per m/s²; null when
+            // not estimated
+            "gyro_g_sensitivity": g_steps,
+            "gyro_g_sensitivity_mean": g_mean,
+            // the log's own segmentation when there was no manifest
+            "segmentation": segmentation,
+            "seconds": secs,
+        }))?
+    );
+    Ok(())
+}
+
+/// The tables of a soak calibration.
+fn print_soak_human(s: &SoakArgs, soak: &driftless::thermal::soak::SoakCalibration, secs: f64) {
+    let g_mean = soak.gyro_g_sensitivity_mean();
     outln!(
         "{} set temperatures {:?} °C; order {} about {} °C; {:.3} s",
         soak.temperatures_c.len(),
@@ -502,7 +520,6 @@ fn soak(s: SoakArgs) -> Result<()> {
     for p in [&s.out, &s.plot].into_iter().flatten() {
         outln!("wrote {}", p.display());
     }
-    Ok(())
 }
 
 /// The manifest of `--manifest`, or without one the log's own segmentation (printed
