@@ -608,3 +608,157 @@ impl Serialize for LogAnalysis {
         st.end()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::Channel;
+    use crate::sim::noise::{StaticNoiseConfig, generate_channels};
+
+    /// A 2-h, 10 Hz static log: three gyro and three accelerometer channels of white
+    /// noise plus rate random walk, a temperature and a channel of another quantity.
+    fn static_log() -> ImuLog {
+        let cfg = |white: f64| StaticNoiseConfig {
+            sample_rate_hz: 10.0,
+            duration_s: 7200.0,
+            white,
+            rate_random_walk: white * 1e-2,
+            ..StaticNoiseConfig::default()
+        };
+        let cfgs = [1e-3, 1.1e-3, 0.9e-3, 2e-3, 2.1e-3, 1.9e-3].map(cfg);
+        let data = generate_channels(&cfgs, 7).expect("valid noise configuration");
+        let n = data[0].len();
+        let mut channels: Vec<Channel> = data
+            .into_iter()
+            .enumerate()
+            .map(|(k, values)| {
+                let q = if k < 3 {
+                    Quantity::AngularRate
+                } else {
+                    Quantity::SpecificForce
+                };
+                Channel {
+                    name: format!("ch{k}"),
+                    quantity: q,
+                    source_unit: q.si_unit().into(),
+                    values,
+                }
+            })
+            .collect();
+        channels.push(Channel {
+            name: "temp".into(),
+            quantity: Quantity::Temperature,
+            source_unit: "degC".into(),
+            values: vec![25.0; n],
+        });
+        channels.push(Channel {
+            name: "pressure".into(),
+            quantity: Quantity::Other,
+            source_unit: "hPa".into(),
+            values: (0..n).map(|i| 1000.0 + (i % 7) as f64 * 0.01).collect(),
+        });
+        ImuLog::new("static-test", None, 0.1, channels)
+    }
+
+    fn opts(channels: ChannelSelection) -> LogAnalysisOptions {
+        LogAnalysisOptions {
+            channels,
+            ..LogAnalysisOptions::allan(
+                AnalysisConfig {
+                    taus: TauSpec::Log(40),
+                    ..AnalysisConfig::default()
+                },
+                Some(FitConfig::IEEE_952),
+            )
+        }
+    }
+
+    #[test]
+    fn channel_selection_and_units() {
+        let log = static_log();
+        let all = analyse_log(&log, &opts(ChannelSelection::AllButTemperature)).unwrap();
+        let names: Vec<&str> = all.results.iter().map(|r| r.name.as_str()).collect();
+        assert_eq!(
+            names,
+            ["ch0", "ch1", "ch2", "ch3", "ch4", "ch5", "pressure"]
+        );
+        assert_eq!(all.units[0], "rad/s");
+        assert_eq!(all.units[6], "hPa", "another quantity keeps the log's unit");
+        let inertial = analyse_log(&log, &opts(ChannelSelection::Inertial)).unwrap();
+        assert_eq!(inertial.results.len(), 6);
+        // The same channel gives the same curve whatever else is analysed (the points:
+        // the lag-1 autocorrelations hold NaN where too few blocks exist).
+        for (a, b) in inertial.results.iter().zip(&all.results) {
+            assert_eq!(a.points, b.points);
+            assert_eq!(a.dev_hi, b.dev_hi);
+        }
+        let model = inertial
+            .noise
+            .as_ref()
+            .expect("the Allan fit was asked for");
+        assert_eq!(model.channels.len(), 6);
+        // White noise of 1e-3 rad/s at 10 Hz: N = σ·√τ0 ≈ 3.2e-4 rad/√s.
+        let n = model.channels[0]
+            .fit
+            .white
+            .expect("white noise resolved")
+            .value;
+        assert!((n / (1e-3 * 0.1f64.sqrt()) - 1.0).abs() < 0.1, "N = {n}");
+        assert_eq!(inertial.fit_curves.len(), 6);
+    }
+
+    #[test]
+    fn refuses_a_log_of_temperatures_and_a_zero_scale() {
+        let mut log = static_log();
+        let e = analyse_log(
+            &log,
+            &LogAnalysisOptions {
+                scale: Some(0.0),
+                ..opts(ChannelSelection::Inertial)
+            },
+        )
+        .unwrap_err();
+        assert!(matches!(e, LogAnalysisError::Scale(_)), "{e}");
+        log.channels.retain(|c| c.quantity == Quantity::Temperature);
+        let e = analyse_log(&log, &opts(ChannelSelection::AllButTemperature)).unwrap_err();
+        assert!(
+            e.to_string().contains("static-test: no data channel"),
+            "{e}"
+        );
+    }
+
+    /// The noise model of the document is the model as saved, each Allan fit carrying
+    /// its χ² verdict: a field added to the model cannot go missing from the document.
+    #[test]
+    fn json_document_is_the_model_with_the_verdict() {
+        let log = static_log();
+        let out = analyse_log(&log, &opts(ChannelSelection::Inertial)).unwrap();
+        let doc = serde_json::to_value(&out).unwrap();
+        let model = out.noise.as_ref().unwrap();
+        let mut want = serde_json::to_value(model).unwrap();
+        for (c, m) in want["channels"]
+            .as_array_mut()
+            .unwrap()
+            .iter_mut()
+            .zip(&model.channels)
+        {
+            let (verdict, warn) = chi2_verdict(m.fit.chi2_reduced);
+            c["fit"]["chi2_verdict"] = verdict.into();
+            c["fit"]["chi2_warning"] = warn.into();
+        }
+        assert_eq!(doc["noise"], want);
+        let keys: Vec<&String> = doc.as_object().unwrap().keys().collect();
+        assert_eq!(keys, ["channels", "lines", "noise", "warnings"]);
+        let ch = &doc["channels"][0];
+        assert_eq!(ch["name"], "ch0");
+        assert_eq!(ch["estimator"], "oadev");
+        assert_eq!(
+            ch["tau"].as_array().unwrap().len(),
+            out.results[0].points.len()
+        );
+        assert_eq!(
+            ch["dev_hi"],
+            serde_json::to_value(&out.results[0].dev_hi).unwrap()
+        );
+    }
+}

@@ -449,3 +449,58 @@ pub fn run_six_position(
         seconds,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::Channel;
+
+    fn log(name: &str, time_s: Vec<f64>, q: Quantity) -> ImuLog {
+        let n = time_s.len();
+        let channels = (0..3)
+            .map(|k| Channel {
+                name: format!("{name}{k}"),
+                quantity: q,
+                source_unit: q.si_unit().into(),
+                values: vec![k as f64; n],
+            })
+            .collect();
+        ImuLog::new(name, Some(time_s), 0.01, channels)
+    }
+
+    #[test]
+    fn paired_logs_must_share_their_instants() {
+        let t: Vec<f64> = (0..100).map(|i| i as f64 * 0.01).collect();
+        let acc = log("acc", t.clone(), Quantity::SpecificForce);
+        let gyro = log("gyro", t.clone(), Quantity::AngularRate);
+        check_sampled_together(("a.csv", &acc), ("g.csv", &gyro)).unwrap();
+        let mut shifted = t.clone();
+        shifted[40] += 0.006;
+        let late = log("gyro", shifted, Quantity::AngularRate);
+        let e = check_sampled_together(("a.csv", &acc), ("g.csv", &late)).unwrap_err();
+        assert!(
+            matches!(e, CalibJobError::NotTogether { sample: 41, .. }),
+            "{e}"
+        );
+        let short = log("gyro", t[..99].to_vec(), Quantity::AngularRate);
+        let e = check_sampled_together(("a.csv", &acc), ("g.csv", &short)).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("a.csv has 100 samples, g.csv has 99"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn triads_by_quantity_or_position() {
+        let t: Vec<f64> = (0..10).map(|i| i as f64 * 0.01).collect();
+        let acc = log("acc", t, Quantity::SpecificForce);
+        let by_q = triad(&acc, Quantity::SpecificForce, 3, "accelerometer").unwrap();
+        assert_eq!(by_q[0], [0.0, 1.0, 2.0]);
+        let e = triad_columns(&acc, Quantity::AngularRate, 3, "gyro").unwrap_err();
+        assert!(
+            e.to_string().contains("needs three gyro columns, found 3"),
+            "{e}"
+        );
+    }
+}

@@ -327,3 +327,17 @@ pub fn run_ramp(
         model_file,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn model_id_is_stable_below_2_63_and_follows_the_coefficients() {
+        let a = model_id(&[1.0, 2.0, 3.0]);
+        assert_eq!(a, model_id(&[1.0, 2.0, 3.0]));
+        assert!(a < 1 << 63);
+        assert_ne!(a, model_id(&[1.0, 2.0, 3.000_000_1]));
+        assert_ne!(a, model_id(&[3.0, 2.0, 1.0]));
+    }
+}
