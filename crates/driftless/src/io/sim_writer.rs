@@ -87,10 +87,16 @@ pub enum SimWriteError {
     Sensor(#[source] toml::ser::Error),
     /// A data file could not be written.
     #[error(transparent)]
-    Log(#[from] LogError),
+    Log(Box<LogError>),
     /// The chamber manifest could not be serialised.
     #[error(transparent)]
     Manifest(#[from] SensorSimError),
+}
+
+impl From<LogError> for SimWriteError {
+    fn from(e: LogError) -> Self {
+        SimWriteError::Log(Box::new(e))
+    }
 }
 
 /// Writes the files of `sim` (run from `sc`) chosen by `families` into `dir` (created if
