@@ -324,74 +324,7 @@ fn nav_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
             med,
             format!("{:.2} µs/epoch", best / n_epochs as f64 * 1e6),
         ));
-        // End to end as KF-GINS is used: its text IMU and GNSS files and YAML in, its
-        // three output files out (`driftless nav --kf-gins`).
-        {
-            use driftless::io::nav::{write_kfgins_gnss, write_kfgins_imu};
-            let dir = a.dir.join("kfgins");
-            std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-            let cols = driftless::nav::pipeline::increment_columns(&incs);
-            let imu_file = dir.join("imu.txt");
-            bench_input(&imu_file, |w| Ok(write_kfgins_imu(w, "imu.txt", &cols)?))?;
-            let imu_mb = std::fs::metadata(&imu_file)?.len() as f64 / 1e6;
-            bench_input(&dir.join("gnss.txt"), |w| {
-                Ok(write_kfgins_gnss(w, "gnss.txt", &g)?)
-            })?;
-            let e0 = driftless::nav::attitude::Euler::from_dcm(&start.q_bn.to_dcm());
-            let yaml = format!(
-                "imupath: \"{}\"\ngnsspath: \"{}\"\noutputpath: \"{}\"\nimudatalen: 7\n\
-                 imudatarate: 200\nstarttime: 0\nendtime: -1\ninitpos: [{}, {}, {}]\n\
-                 initvel: [{}, {}, {}]\ninitatt: [{}, {}, {}]\ninitgyrbias: [0, 0, 0]\n\
-                 initaccbias: [0, 0, 0]\ninitgyrscale: [0, 0, 0]\ninitaccscale: [0, 0, 0]\n\
-                 initposstd: [0.05, 0.05, 0.05]\ninitvelstd: [0.05, 0.05, 0.05]\n\
-                 initattstd: [0.5, 0.5, 0.5]\nimunoise:\n  arw: [0.5, 0.5, 0.5]\n\
-                 \x20 vrw: [0.1, 0.1, 0.1]\n  gbstd: [100, 100, 100]\n  abstd: [5000, 5000, 5000]\n\
-                 \x20 gsstd: [5000, 5000, 5000]\n  asstd: [5000, 5000, 5000]\n  corrtime: 1.0\n\
-                 antlever: [0, 0, 0]\n",
-                dir.join("imu.txt").display(),
-                dir.join("gnss.txt").display(),
-                dir.join("out").display(),
-                start.lat_rad.to_degrees(),
-                start.lon_rad.to_degrees(),
-                start.height_m,
-                start.vel_ned_m_s[0],
-                start.vel_ned_m_s[1],
-                start.vel_ned_m_s[2],
-                e0.roll_rad.to_degrees(),
-                e0.pitch_rad.to_degrees(),
-                e0.yaw_rad.to_degrees()
-            );
-            let cfg_path = dir.join("kf-gins.yaml");
-            driftless::io::output::write(&cfg_path, yaml)?;
-            let (kbest, kmed) = time_runs(a.runs.min(3), || {
-                driftless::nav::kfgins_job::run_kf_gins_job(&cfg_path, &Default::default())
-                    .map(|_| ())
-                    .map_err(Into::into)
-            })?;
-            results.push((
-                format!(
-                    "driftless nav --kf-gins end to end: {imu_mb:.0} MB IMU text + GNSS + YAML in, 3 KF-GINS files out"
-                ),
-                kbest,
-                kmed,
-                format!("{:.2} µs/epoch", kbest / n_epochs as f64 * 1e6),
-            ));
-            // The same job as a whole process (start-up, reading, filtering, writing and
-            // exit), the files in `--dir`, as `/usr/bin/time driftless nav --kf-gins`.
-            let whole = whole_process_runs(a.runs, &cfg_path)?;
-            results.push((
-                format!(
-                    "driftless nav --kf-gins as a whole process (spawned), files to {}",
-                    dir.join("out").display()
-                ),
-                whole.best_s,
-                whole.median_s,
-                whole.note(n_epochs),
-            ));
-            if !a.keep {
-                let _ = std::fs::remove_dir_all(&dir);
-            }
-        }
+        kfgins_benches(a, results, &incs, &g, &start)?;
         if let Some(run) = &last_run {
             let (sbest, smed) = time_runs(a.runs.min(3), || Ok(smooth(run, &init, &cfg)?))?;
             results.push((
@@ -403,6 +336,83 @@ fn nav_benches(a: &BenchArgs, results: &mut Results) -> Result<()> {
         }
     }
 
+    Ok(())
+}
+
+/// End to end as KF-GINS is used: its text IMU and GNSS files and YAML in, its three
+/// output files out (`driftless nav --kf-gins`), in-process and as a whole process.
+fn kfgins_benches(
+    a: &BenchArgs,
+    results: &mut Results,
+    incs: &[driftless::nav::mechanization::ImuIncrement],
+    g: &driftless::io::nav::GnssFixes,
+    start: &driftless::nav::mechanization::NavState,
+) -> Result<()> {
+    let n_epochs = incs.len();
+    use driftless::io::nav::{write_kfgins_gnss, write_kfgins_imu};
+    let dir = a.dir.join("kfgins");
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let cols = driftless::nav::pipeline::increment_columns(incs);
+    let imu_file = dir.join("imu.txt");
+    bench_input(&imu_file, |w| Ok(write_kfgins_imu(w, "imu.txt", &cols)?))?;
+    let imu_mb = std::fs::metadata(&imu_file)?.len() as f64 / 1e6;
+    bench_input(&dir.join("gnss.txt"), |w| {
+        Ok(write_kfgins_gnss(w, "gnss.txt", g)?)
+    })?;
+    let e0 = driftless::nav::attitude::Euler::from_dcm(&start.q_bn.to_dcm());
+    let yaml = format!(
+        "imupath: \"{}\"\ngnsspath: \"{}\"\noutputpath: \"{}\"\nimudatalen: 7\n\
+         imudatarate: 200\nstarttime: 0\nendtime: -1\ninitpos: [{}, {}, {}]\n\
+         initvel: [{}, {}, {}]\ninitatt: [{}, {}, {}]\ninitgyrbias: [0, 0, 0]\n\
+         initaccbias: [0, 0, 0]\ninitgyrscale: [0, 0, 0]\ninitaccscale: [0, 0, 0]\n\
+         initposstd: [0.05, 0.05, 0.05]\ninitvelstd: [0.05, 0.05, 0.05]\n\
+         initattstd: [0.5, 0.5, 0.5]\nimunoise:\n  arw: [0.5, 0.5, 0.5]\n\
+         \x20 vrw: [0.1, 0.1, 0.1]\n  gbstd: [100, 100, 100]\n  abstd: [5000, 5000, 5000]\n\
+         \x20 gsstd: [5000, 5000, 5000]\n  asstd: [5000, 5000, 5000]\n  corrtime: 1.0\n\
+         antlever: [0, 0, 0]\n",
+        dir.join("imu.txt").display(),
+        dir.join("gnss.txt").display(),
+        dir.join("out").display(),
+        start.lat_rad.to_degrees(),
+        start.lon_rad.to_degrees(),
+        start.height_m,
+        start.vel_ned_m_s[0],
+        start.vel_ned_m_s[1],
+        start.vel_ned_m_s[2],
+        e0.roll_rad.to_degrees(),
+        e0.pitch_rad.to_degrees(),
+        e0.yaw_rad.to_degrees()
+    );
+    let cfg_path = dir.join("kf-gins.yaml");
+    driftless::io::output::write(&cfg_path, yaml)?;
+    let (kbest, kmed) = time_runs(a.runs.min(3), || {
+        driftless::nav::kfgins_job::run_kf_gins_job(&cfg_path, &Default::default())
+            .map(|_| ())
+            .map_err(Into::into)
+    })?;
+    results.push((
+        format!(
+            "driftless nav --kf-gins end to end: {imu_mb:.0} MB IMU text + GNSS + YAML in, 3 KF-GINS files out"
+        ),
+        kbest,
+        kmed,
+        format!("{:.2} µs/epoch", kbest / n_epochs as f64 * 1e6),
+    ));
+    // The same job as a whole process (start-up, reading, filtering, writing and
+    // exit), the files in `--dir`, as `/usr/bin/time driftless nav --kf-gins`.
+    let whole = whole_process_runs(a.runs, &cfg_path)?;
+    results.push((
+        format!(
+            "driftless nav --kf-gins as a whole process (spawned), files to {}",
+            dir.join("out").display()
+        ),
+        whole.best_s,
+        whole.median_s,
+        whole.note(n_epochs),
+    ));
+    if !a.keep {
+        let _ = std::fs::remove_dir_all(&dir);
+    }
     Ok(())
 }
 

@@ -9,16 +9,13 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
-use driftless::calib::model_file::{CalibrationFile, FORMAT_VERSION, TriadEntry};
-use driftless::calib::multi_position::{MultiPositionOptions, calibrate_multi_position};
+use driftless::calib::job::{MultiPositionLogs, run_multi_position, run_six_position};
+use driftless::calib::model_file::{CalibrationFile, TriadEntry};
+use driftless::calib::multi_position::MultiPositionOptions;
 use driftless::calib::protocol::ChamberManifest;
 use driftless::calib::quality::FitQuality;
-use driftless::calib::six_position::{SixPositionInput, SixPositionOptions, calibrate};
-use driftless::io::{ImuLog, Quantity};
-use driftless_model::calib::TriadCalibration;
-use driftless_model::linalg::Vec3;
+use driftless::io::ImuLog;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use crate::input::InputArgs;
 
@@ -137,59 +134,6 @@ fn read(input: &InputArgs, path: &Path) -> Result<ImuLog> {
     input.read(path)
 }
 
-/// Three columns of `log`: by quantity when it has exactly three of it (units given),
-/// else the channels at `first..first + 3` (raw counts).
-fn triad_columns<'a>(
-    log: &'a ImuLog,
-    q: Quantity,
-    first: usize,
-    what: &str,
-) -> Result<[&'a [f64]; 3]> {
-    if let Some(t) = log.triad_of(q) {
-        return Ok(t);
-    }
-    if first + 3 > log.channels.len() {
-        bail!(
-            "{}: needs three {what} columns, found {} data columns",
-            log.source,
-            log.channels.len()
-        );
-    }
-    Ok(std::array::from_fn(|k| {
-        log.channels[first + k].values.as_slice()
-    }))
-}
-
-/// [`triad_columns`] as one vector per sample.
-fn triad(log: &ImuLog, q: Quantity, first: usize, what: &str) -> Result<Vec<Vec3>> {
-    let c = triad_columns(log, q, first, what)?;
-    Ok((0..log.len()).map(|i| c.map(|col| col[i])).collect())
-}
-
-fn entry(
-    cal: &TriadCalibration,
-    bias_sigma: Vec3,
-    matrix_sigma: [[f64; 3]; 3],
-    unit: &str,
-    rms: Option<f64>,
-) -> TriadEntry {
-    TriadEntry {
-        raw_unit: unit.into(),
-        bias: cal.bias,
-        bias_sigma,
-        matrix: cal.matrix.0,
-        matrix_sigma,
-        residual_rms: rms,
-    }
-}
-
-fn raw_unit(log: &ImuLog, q: Quantity) -> String {
-    match log.channels.iter().find(|c| c.quantity == q) {
-        Some(_) => q.si_unit().to_string(),
-        None => "raw".into(),
-    }
-}
-
 fn multi(m: MultiArgs) -> Result<()> {
     crate::paths::refuse_outputs_over_inputs(
         &[m.common.out.as_deref(), m.common.plot.as_deref()],
@@ -197,92 +141,29 @@ fn multi(m: MultiArgs) -> Result<()> {
     )?;
     let g = gravity(&m.common)?;
     let acc_log = read(&m.common.input, &m.accel)?;
-    let (accel, gyro, gyro_log) = match &m.gyro {
-        Some(p) => {
-            let gl = read(&m.common.input, p)?;
-            if gl.len() != acc_log.len() {
-                bail!(
-                    "{} has {} samples, {} has {}: the two files must be sampled together",
-                    m.accel.display(),
-                    acc_log.len(),
-                    p.display(),
-                    gl.len()
-                );
-            }
-            // Sampled together means at the same instants: a file's own time stamps are
-            // not set aside for its row order.
-            if let (Some(ta), Some(tg)) = (&acc_log.time_s, &gl.time_s) {
-                let tol = 0.5 * acc_log.tau0_s.min(gl.tau0_s);
-                if let Some(i) = ta
-                    .iter()
-                    .zip(tg)
-                    .position(|(a, b)| (a - b).abs().is_nan() || (a - b).abs() > tol)
-                {
-                    bail!(
-                        "{} and {} are not sampled together: sample {} is at t = {} s in the \
-                         first and t = {} s in the second (more than half a sample interval \
-                         apart); give files recorded at the same instants, or one file with \
-                         both triads",
-                        m.accel.display(),
-                        p.display(),
-                        i + 1,
-                        ta[i],
-                        tg[i]
-                    );
-                }
-            }
-            (
-                triad(&acc_log, Quantity::SpecificForce, 0, "accelerometer")?,
-                triad(&gl, Quantity::AngularRate, 0, "gyro")?,
-                gl,
-            )
-        }
-        None => (
-            triad(&acc_log, Quantity::SpecificForce, 0, "accelerometer")?,
-            triad(&acc_log, Quantity::AngularRate, 3, "gyro")?,
-            acc_log.clone(),
-        ),
+    let gyro_log = match &m.gyro {
+        Some(p) => Some((p.display().to_string(), read(&m.common.input, p)?)),
+        None => None,
     };
-    let Some(time) = acc_log.time_s.clone() else {
-        bail!("{}: no time column", m.accel.display());
+    let acc_name = m.accel.display().to_string();
+    let logs = MultiPositionLogs {
+        accel: (&acc_name, &acc_log),
+        gyro: gyro_log.as_ref().map(|(n, l)| (n.as_str(), l)),
     };
-    let offset: Vec3 = match m.accel_offset {
-        Some(o) => [o; 3],
-        None => std::array::from_fn(|k| {
-            let mut v: Vec<f64> = accel.iter().map(|a| a[k]).collect();
-            v.sort_by(f64::total_cmp);
-            let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
-            0.5 * (at(0.01) + at(0.99))
-        }),
-    };
-    let mut opts = MultiPositionOptions {
+    let opts = MultiPositionOptions {
         gravity_m_s2: g,
         gyro_scale_guess_rad_s_per_raw: m.gyro_scale_guess,
         ..MultiPositionOptions::default()
     };
-    opts.detect.accel_offset_raw = offset;
-    let sources = match &m.gyro {
-        Some(p) => format!("{} + {}", m.accel.display(), p.display()),
-        None => m.accel.display().to_string(),
-    };
-    let span = match (time.first(), time.last()) {
-        (Some(a), Some(b)) => format!("{a:.2}–{b:.2} s"),
-        _ => "empty".into(),
-    };
-    let t = Instant::now();
-    let res = calibrate_multi_position(&time, &accel, &gyro, &opts)
-        .with_context(|| format!("calibrating {sources} ({span})"))?;
-    let secs = t.elapsed().as_secs_f64();
-    let implausible: Vec<&String> = res
-        .accel_quality
-        .implausible
-        .iter()
-        .chain(&res.gyro_quality.implausible)
-        .collect();
+    let run = run_multi_position(logs, m.accel_offset, &opts)?;
+    let (res, file, secs) = (&run.result, &run.file, run.seconds);
+    let implausible = run.implausible();
     if !implausible.is_empty() && !m.accept_poor_fit {
         let list: Vec<String> = implausible.iter().map(|r| format!("  - {r}")).collect();
         bail!(
-            "{sources} ({span}): the multi-position calibration is implausible, so it was not written:\n{}\n(pass --accept-poor-fit to keep it anyway)",
+            "{} ({}): the multi-position calibration is implausible, so it was not written:\n{}\n(pass --accept-poor-fit to keep it anyway)",
+            run.sources,
+            run.span,
             list.join("\n")
         );
     }
@@ -290,42 +171,11 @@ fn multi(m: MultiArgs) -> Result<()> {
         ("accelerometer", &res.accel_quality),
         ("gyro", &res.gyro_quality),
     ];
-    let intervals: Vec<[f64; 2]> = res
-        .intervals
-        .iter()
-        .map(|iv| [iv.start_time_s, iv.end_time_s])
-        .collect();
-    let file = CalibrationFile {
-        format_version: FORMAT_VERSION,
-        method: "multi-position".into(),
-        source: sources.clone(),
-        gravity_m_s2: g,
-        accel: entry(
-            &res.accel.calibration,
-            res.accel.bias_sigma(),
-            res.accel.matrix_sigma().0,
-            &raw_unit(&acc_log, Quantity::SpecificForce),
-            Some(res.accel_norm_rms_m_s2),
-        ),
-        gyro: entry(
-            &res.gyro.calibration,
-            res.gyro.bias_sigma(),
-            res.gyro.matrix_sigma().0,
-            &raw_unit(&gyro_log, Quantity::AngularRate),
-            Some(res.gravity_angle_rms_rad),
-        ),
-        static_intervals: intervals,
-        gyro_g_sensitivity: None,
-    };
-    let resid: Vec<f64> = res
-        .intervals
-        .iter()
-        .map(|iv| driftless_model::linalg::norm(res.accel.calibration.apply(iv.mean_accel_raw)) - g)
-        .collect();
+    let resid = &run.residuals_m_s2;
     let residuals: Vec<Vec<String>> = res
         .intervals
         .iter()
-        .zip(&resid)
+        .zip(resid)
         .enumerate()
         .map(|(i, (iv, r))| {
             vec![
@@ -348,24 +198,7 @@ fn multi(m: MultiArgs) -> Result<()> {
         )
         .with_context(|| format!("writing {}", p.display()))?;
     }
-    // Before: the nominal zero offset and the best single scale s (least squares of
-    // s·|ā − o| = g over the intervals: s = g·Σ|r| / Σ|r|²).
-    let r: Vec<f64> = res
-        .intervals
-        .iter()
-        .map(|iv| {
-            driftless_model::linalg::norm(driftless_model::linalg::sub(iv.mean_accel_raw, offset))
-        })
-        .collect();
-    let single = g * r.iter().sum::<f64>() / r.iter().map(|v| v * v).sum::<f64>().max(1e-300);
-    let before = driftless::calib::multi_position::accel_norm_rms(
-        &res.intervals,
-        &TriadCalibration {
-            bias: offset,
-            matrix: driftless_model::linalg::Mat3::diag([single; 3]),
-        },
-        g,
-    );
+    let before = run.before_rms_m_s2;
     let summary = [
         ("static intervals", format!("{}", res.intervals.len())),
         (
@@ -414,7 +247,7 @@ fn multi(m: MultiArgs) -> Result<()> {
     });
     output(
         &m.common,
-        &file,
+        file,
         &summary,
         secs,
         (["#", "interval [s]", "pose", "|a| − g [m/s²]"], residuals),
@@ -505,72 +338,36 @@ fn six_calibrate(
     source: String,
     segmentation: Option<serde_json::Value>,
 ) -> Result<()> {
-    let rate = 1.0 / log.tau0_s;
-    if (rate - manifest.sample_rate_hz).abs() > 1e-6 * rate {
-        bail!(
-            "{} is sampled at {rate} Hz, the manifest at {} Hz",
-            s.log.display(),
-            manifest.sample_rate_hz
-        );
-    }
-    let gyro = triad_columns(log, Quantity::AngularRate, 0, "gyro")?;
-    let accel = triad_columns(log, Quantity::SpecificForce, 3, "accelerometer")?;
-    let input = SixPositionInput::from_manifest_columns(manifest, accel, gyro, 1.0, temp)?;
-    let mut opts = SixPositionOptions::from_manifest(manifest);
-    opts.estimate_g_sensitivity = s.g_sensitivity;
-    if s.common.gravity.is_some() {
-        opts.gravity_m_s2 = gravity(&s.common)?;
-    }
-    let t = Instant::now();
-    let res = calibrate(&input, &opts)?;
-    let secs = t.elapsed().as_secs_f64();
+    let gravity = match s.common.gravity {
+        Some(_) => Some(gravity(&s.common)?),
+        None => None,
+    };
+    let run = run_six_position(
+        log,
+        &s.log.display().to_string(),
+        manifest,
+        temp,
+        gravity,
+        s.g_sensitivity,
+        source,
+    )?;
+    let (input, res, file, secs) = (&run.input, &run.result, &run.file, run.seconds);
     let (accel_quality, gyro_quality) =
         res.quality(driftless::calib::quality::DEFAULT_WARN_CHI2_PER_DOF);
-    let file = CalibrationFile {
-        format_version: FORMAT_VERSION,
-        method: "six-position".into(),
-        source,
-        gravity_m_s2: opts.gravity_m_s2,
-        accel: entry(
-            &res.accel.calibration,
-            res.accel.bias_sigma(),
-            res.accel.matrix_sigma(),
-            &raw_unit(log, Quantity::SpecificForce),
-            None,
-        ),
-        gyro: entry(
-            &res.gyro.calibration,
-            res.gyro.bias_sigma(),
-            res.gyro.matrix_sigma(),
-            &raw_unit(log, Quantity::AngularRate),
-            None,
-        ),
-        static_intervals: Vec::new(),
-        gyro_g_sensitivity: res
-            .gyro_g_sensitivity
-            .as_ref()
-            .map(|g| g.matrix_raw_per_m_s2.0),
-    };
-    let g = opts.gravity_m_s2;
     if let Some(p) = &s.common.plot {
-        let (mut norm_r, mut comp) = (Vec::new(), [Vec::new(), Vec::new(), Vec::new()]);
-        for pos in &input.positions {
-            let a = res.accel.calibration.apply(pos.accel_raw);
-            let d = driftless_model::linalg::sub(a, pos.c_bn.t().mul_vec([0.0, 0.0, -g]));
-            norm_r.push(driftless_model::linalg::norm(a) - g);
-            for k in 0..3 {
-                comp[k].push(d[k]);
-            }
-        }
-        let [cx, cy, cz] = comp;
+        let comp = |k: usize| run.residuals.iter().map(|r| r.a_minus_g_m_s2[k]).collect();
         driftless::report::calib_plot::write_residual_plot(
             p,
             &format!("six-position calibration of {}", s.log.display()),
             &[
-                ("|a| − g", "m/s²", norm_r),
-                ("a − g·up, x", "m/s²", cx),
-                ("a − g·up, y", "m/s²", cy),
-                ("a − g·up, z", "m/s²", cz),
+                (
+                    "|a| − g",
+                    "m/s²",
+                    run.residuals.iter().map(|r| r.norm_m_s2).collect(),
+                ),
+                ("a − g·up, x", "m/s²", comp(0)),
+                ("a − g·up, y", "m/s²", comp(1)),
+                ("a − g·up, z", "m/s²", comp(2)),
             ],
         )
         .with_context(|| format!("writing {}", p.display()))?;
@@ -578,15 +375,14 @@ fn six_calibrate(
     let residuals: Vec<Vec<String>> = input
         .positions
         .iter()
-        .map(|p| {
-            let a = res.accel.calibration.apply(p.accel_raw);
-            let want = p.c_bn.t().mul_vec([0.0, 0.0, -g]);
-            let d = driftless_model::linalg::sub(a, want);
+        .zip(&run.residuals)
+        .map(|(p, r)| {
+            let d = r.a_minus_g_m_s2;
             vec![
                 format!("{}", p.up),
                 format!("{}", p.n),
                 format!("{:+.2e} {:+.2e} {:+.2e}", d[0], d[1], d[2]),
-                format!("{:+.2e}", driftless_model::linalg::norm(a) - g),
+                format!("{:+.2e}", r.norm_m_s2),
             ]
         })
         .collect();
@@ -606,7 +402,7 @@ fn six_calibrate(
     ];
     output(
         &s.common,
-        &file,
+        file,
         &summary,
         secs,
         (

@@ -49,7 +49,7 @@ pub fn run(a: ConvertArgs) -> Result<()> {
         );
     };
     crate::paths::refuse_outputs_over_inputs(&[Some(&a.output)], &[Some(&a.input)])?;
-    let log = crate::allan_cmd::read_with_progress(&a.read, &a.input, false)?;
+    let log = crate::progress::read_with_progress(&a.read, &a.input, false)?;
     match format {
         LogFormat::Text => driftless::io::write_csv_file(&log, &a.output),
         LogFormat::Binary => driftless::io::write_binary_file(&log, &a.output),

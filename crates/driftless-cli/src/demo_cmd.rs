@@ -3,23 +3,22 @@
 //! the noise-analysis demo — an 18-h, 100 Hz static six-axis IMU log with known noise
 //! terms, the Allan analysis and noise fit on it, compared with the truth.
 
-use crate::allan_cmd::{AllanOutput, analyse_log, json_output};
 use crate::output::{Table, sci};
-use anyhow::{Context, Result};
+use crate::progress::spinner;
+use anyhow::Result;
 use clap::Args;
 use driftless::allan::analysis::AnalysisConfig;
-use driftless::allan::fit::{FitConfig, NoiseFit};
+use driftless::allan::fit::FitConfig;
+use driftless::allan::log_analysis::{LogAnalysis, LogAnalysisOptions, analyse_log};
 use driftless::allan::taus::TauSpec;
 use driftless::allan::{DataType, Estimator};
 use driftless::io::{Channel, ImuLog, Quantity};
-use driftless::report::allan_plot;
 use driftless::sim::noise::{StaticNoiseConfig, generate_channels};
 use driftless_model::units::{
     DEG_PER_H, DEG_PER_H_PER_SQRT_H, DEG_PER_SQRT_H, M_PER_S_PER_SQRT_H, MICRO_G,
 };
-use indicatif::{ProgressBar, ProgressStyle};
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::path::PathBuf;
+use std::time::Instant;
 
 #[derive(Args, Debug)]
 pub struct DemoArgs {
@@ -55,22 +54,6 @@ pub struct DemoArgs {
     /// Print the JSON document of `driftless allan --json` instead of tables.
     #[arg(long)]
     pub json: bool,
-}
-
-/// A spinner on stderr (hidden when not a terminal, when `show` is false, or with
-/// `--quiet`).
-pub fn spinner(show: bool, msg: String) -> ProgressBar {
-    if !show || crate::verbosity::quiet() {
-        return ProgressBar::hidden();
-    }
-    let pb = ProgressBar::new_spinner();
-    pb.set_style(
-        ProgressStyle::with_template("{spinner} {msg} [{elapsed}]")
-            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-    );
-    pb.set_message(msg);
-    pb.enable_steady_tick(Duration::from_millis(120));
-    pb
 }
 
 /// The demo's true noise terms, per axis (ADIS16465-1-class numbers: ARW 0.15 deg/√h,
@@ -113,11 +96,11 @@ pub fn run(a: DemoArgs) -> Result<()> {
     }
     if !a.noise {
         let sc = driftless::experiment::ExperimentScenario::builtin_adi_like()?;
-        let out = crate::experiment_cmd::OutputFolder {
+        let out = crate::experiment_run::OutputFolder {
             dir: &a.out,
             force: a.force,
         };
-        return crate::experiment_cmd::run_scenario(sc, out, a.runs, a.json);
+        return crate::experiment_run::run_scenario(sc, out, a.runs, a.json);
     }
     noise_demo(a)
 }
@@ -182,12 +165,12 @@ fn noise_demo(a: DemoArgs) -> Result<()> {
         rate_random_walk: true,
         ..FitConfig::NONE
     };
-    let out = analyse_log(&log, &cfg, Some(&fit_cfg), None, true)?;
+    let out = analyse_log(&log, &LogAnalysisOptions::allan(cfg, Some(fit_cfg)))?;
     let t_allan = t0.elapsed();
     sp.finish_and_clear();
 
     let plot_path = a.out.join("allan.svg");
-    write_plot(
+    crate::plots::write_allan_plot(
         &plot_path,
         &out,
         "driftless demo: simulated 18-h static IMU",
@@ -196,13 +179,11 @@ fn noise_demo(a: DemoArgs) -> Result<()> {
     if let Some(m) = &out.noise {
         m.save(&model_path)?;
     }
-    driftless::io::output::write(
-        a.out.join("allan.json"),
-        serde_json::to_string_pretty(&json_output(&out))?,
-    )?;
+    let json = crate::output::json_text(&out)?;
+    driftless::io::output::write(a.out.join("allan.json"), &json)?;
 
     if a.json {
-        outln!("{}", serde_json::to_string_pretty(&json_output(&out))?);
+        outln!("{json}");
         return Ok(());
     }
     outln!(
@@ -233,7 +214,7 @@ fn noise_demo(a: DemoArgs) -> Result<()> {
 }
 
 /// Fitted vs true terms, in display units, with the error relative to truth.
-fn truth_table(truth: &[(String, Quantity, StaticNoiseConfig)], out: &AllanOutput) -> String {
+fn truth_table(truth: &[(String, Quantity, StaticNoiseConfig)], out: &LogAnalysis) -> String {
     let mut t = Table::new([
         "channel", "term", "unit", "true", "fitted", "lo", "hi", "error",
     ]);
@@ -295,21 +276,4 @@ fn truth_table(truth: &[(String, Quantity, StaticNoiseConfig)], out: &AllanOutpu
         "fitted noise terms vs the simulation's truth\n{}",
         t.render()
     )
-}
-
-/// Write the Allan plot of `out` to `path` (SVG, or PNG by extension).
-pub fn write_plot(path: &Path, out: &AllanOutput, title: &str) -> Result<()> {
-    let fits: Vec<Option<&NoiseFit>> = match &out.noise {
-        Some(m) => m.fits().map(Some).collect(),
-        None => vec![None; out.results.len()],
-    };
-    allan_plot::write(
-        path,
-        title,
-        &out.results,
-        &out.quantities,
-        &out.units,
-        &fits,
-    )
-    .with_context(|| format!("writing plot {}", path.display()))
 }

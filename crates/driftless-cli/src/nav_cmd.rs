@@ -9,7 +9,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
 use driftless::eval::SelectedOutage;
 use driftless::nav::config::{KEYS, NavConfig, Override, ValueKind};
-use driftless::nav::job::run_nav_job;
+use driftless::nav::job::{NavJobResult, run_nav_job};
 use driftless::nav::session::solution_records;
 use std::path::PathBuf;
 
@@ -267,55 +267,71 @@ pub fn run(a: NavArgs) -> Result<()> {
         .filter_map(|o| o.end_horizontal_m)
         .collect();
     let mean_end = (!ends.is_empty()).then(|| ends.iter().sum::<f64>() / ends.len() as f64);
-    let sc = &job.session_config;
     if a.json {
-        let v = serde_json::json!({
-            "imu_epochs": job.imu.len(),
-            "imu_format": format!("{:?}", job.imu_format),
-            "imu_rate_hz": 1.0 / job.imu.nominal_dt_s,
-            "gnss_fixes": job.fixes.time_s.len(),
-            "gnss_dropped_by_quality": job.dropped_by_quality,
-            "start_time_s": res.init.nav.time_s,
-            "gnss_accepted": run.gnss_accepted,
-            "gnss_rejected": run.gnss_rejected,
-            "gnss_withheld": run.gnss_withheld,
-            "gnss_forced": run.gnss_forced,
-            "gnss_sigma_floor": if sc.auto_sigma_floor { "auto" } else { "fixed" },
-            "gnss_sigma_floors": res.sigma_floors.iter().map(|f| serde_json::json!({
-                "quality": quality_name(f.quality), "kind": format!("{:?}", f.kind).to_lowercase(),
-                "fixes": f.fixes, "horizontal": f.horizontal, "vertical": f.vertical,
-                "file_sigma_horizontal": f.file_sigma.0, "file_sigma_vertical": f.file_sigma.1,
-            })).collect::<Vec<_>>(),
-            "horizontal_rms_m": res.horizontal_rms_m.map(|r| r.0),
-            "horizontal_rms_fixes": res.horizontal_rms_m.map(|r| r.1),
-            "outages": res.outages.iter().map(|o| serde_json::json!({
-                "start_s": o.window.start_s, "end_s": o.window.end_s,
-                "end_horizontal_m": o.end_horizontal_m, "max_horizontal_m": o.max_horizontal_m,
-                "end_vertical_m": o.end_vertical_m,
-            })).collect::<Vec<_>>(),
-            "mean_end_horizontal_m": mean_end,
-            "gnss_resets": run.gnss_resets,
-            "gnss_recoveries": run.recoveries.iter().map(|e| serde_json::json!({
-                "time_s": e.time_s,
-                "trigger": match e.trigger {
-                    driftless::nav::filter::RecoveryTrigger::Rejections => "rejections",
-                    driftless::nav::filter::RecoveryTrigger::Time => "time",
-                },
-                "rejected_fixes": e.rejected_fixes, "starved_s": e.starved_s,
-                "horizontal_innovation_m": e.horizontal_innovation_m,
-                "reset": e.reset, "yaw_from_course": e.yaw_from_course,
-            })).collect::<Vec<_>>(),
-            "imu_check": imu_check_json(&job.imu_check),
-            "outage_selection": job.selection,
-            "smoothed_outages": res.smoothed_outages.as_ref().map(|v| v.iter().map(|o| serde_json::json!({
-                "start_s": o.window.start_s, "end_s": o.window.end_s,
-                "end_horizontal_m": o.end_horizontal_m, "max_horizontal_m": o.max_horizontal_m,
-            })).collect::<Vec<_>>()),
-            "notes": job.notes,
-        });
-        outln!("{}", serde_json::to_string_pretty(&v)?);
-        return Ok(());
+        return print_json(&job, mean_end);
     }
+    print_human(&a, &job, mean_end, ends.len());
+    Ok(())
+}
+
+/// The `--json` document of a run.
+fn print_json(job: &NavJobResult, mean_end: Option<f64>) -> Result<()> {
+    let res = &job.session;
+    let run = &res.run;
+    let sc = &job.session_config;
+    let v = serde_json::json!({
+        "imu_epochs": job.imu.len(),
+        "imu_format": format!("{:?}", job.imu_format),
+        "imu_rate_hz": 1.0 / job.imu.nominal_dt_s,
+        "gnss_fixes": job.fixes.time_s.len(),
+        "gnss_dropped_by_quality": job.dropped_by_quality,
+        "start_time_s": res.init.nav.time_s,
+        "gnss_accepted": run.gnss_accepted,
+        "gnss_rejected": run.gnss_rejected,
+        "gnss_withheld": run.gnss_withheld,
+        "gnss_forced": run.gnss_forced,
+        "gnss_sigma_floor": if sc.auto_sigma_floor { "auto" } else { "fixed" },
+        "gnss_sigma_floors": res.sigma_floors.iter().map(|f| serde_json::json!({
+            "quality": quality_name(f.quality), "kind": format!("{:?}", f.kind).to_lowercase(),
+            "fixes": f.fixes, "horizontal": f.horizontal, "vertical": f.vertical,
+            "file_sigma_horizontal": f.file_sigma.0, "file_sigma_vertical": f.file_sigma.1,
+        })).collect::<Vec<_>>(),
+        "horizontal_rms_m": res.horizontal_rms_m.map(|r| r.0),
+        "horizontal_rms_fixes": res.horizontal_rms_m.map(|r| r.1),
+        "outages": res.outages.iter().map(|o| serde_json::json!({
+            "start_s": o.window.start_s, "end_s": o.window.end_s,
+            "end_horizontal_m": o.end_horizontal_m, "max_horizontal_m": o.max_horizontal_m,
+            "end_vertical_m": o.end_vertical_m,
+        })).collect::<Vec<_>>(),
+        "mean_end_horizontal_m": mean_end,
+        "gnss_resets": run.gnss_resets,
+        "gnss_recoveries": run.recoveries.iter().map(|e| serde_json::json!({
+            "time_s": e.time_s,
+            "trigger": match e.trigger {
+                driftless::nav::filter::RecoveryTrigger::Rejections => "rejections",
+                driftless::nav::filter::RecoveryTrigger::Time => "time",
+            },
+            "rejected_fixes": e.rejected_fixes, "starved_s": e.starved_s,
+            "horizontal_innovation_m": e.horizontal_innovation_m,
+            "reset": e.reset, "yaw_from_course": e.yaw_from_course,
+        })).collect::<Vec<_>>(),
+        "imu_check": imu_check_json(&job.imu_check),
+        "outage_selection": job.selection,
+        "smoothed_outages": res.smoothed_outages.as_ref().map(|v| v.iter().map(|o| serde_json::json!({
+            "start_s": o.window.start_s, "end_s": o.window.end_s,
+            "end_horizontal_m": o.end_horizontal_m, "max_horizontal_m": o.max_horizontal_m,
+        })).collect::<Vec<_>>()),
+        "notes": job.notes,
+    });
+    outln!("{}", serde_json::to_string_pretty(&v)?);
+    Ok(())
+}
+
+/// The tables of a run.
+fn print_human(a: &NavArgs, job: &NavJobResult, mean_end: Option<f64>, n_ends: usize) {
+    let res = &job.session;
+    let run = &res.run;
+    let sc = &job.session_config;
     outln!(
         "{} IMU epochs at {:.1} Hz ({:?}), {} GNSS fixes in the IMU span; filter started at {:.2} s",
         job.imu.len(),
@@ -397,14 +413,13 @@ pub fn run(a: NavArgs) -> Result<()> {
         if let Some(m) = mean_end {
             outln!(
                 "mean end-of-outage horizontal error {m:.2} m over {} outages",
-                ends.len()
+                n_ends
             );
         }
     }
     if let Some(dir) = &a.out {
         outln!("KF-GINS-format outputs written to {}", dir.display());
     }
-    Ok(())
 }
 
 /// The IMU value findings on stderr as warnings (at most `max` lines).

@@ -1,4 +1,12 @@
-//! Human-readable tables, and checks of output names made before any work is done.
+//! Human-readable tables, JSON documents, and checks of output names made before any
+//! work is done.
+
+/// A `--json` document as printed: pretty, with the keys of every object sorted (as
+/// `serde_json`'s own maps keep them, so documents built from typed results and from
+/// maps read alike).
+pub fn json_text<T: serde::Serialize>(doc: &T) -> anyhow::Result<String> {
+    Ok(serde_json::to_string_pretty(&serde_json::to_value(doc)?)?)
+}
 
 /// `--plot FILE` value parser: the name must end in `.svg` or `.png` (PNG only in a build
 /// with the `png` feature), so a long analysis never ends in a refused or mislabelled file.

@@ -11,13 +11,12 @@
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use driftless::calib::protocol::ChamberManifest;
-use driftless::calib::six_position::SixPositionOptions;
 use driftless::io::ImuLog;
-use driftless::io::Quantity;
 use driftless::thermal::FitOptions;
-use driftless::thermal::check::{CheckOptions, FindingKind, Impact, ThermalCheck, check_log};
+use driftless::thermal::check::{CheckOptions, Impact, ThermalCheck, check_log};
+use driftless::thermal::job::{RampInput, ramp_precheck, run_ramp, run_soak, soak_precheck};
 use driftless::thermal::model_file::ThermalModelFile;
-use driftless::thermal::soak::soak_calibration;
+use driftless::thermal::ramp::RampOptions;
 use driftless_model::compensation::OutOfRange;
 use std::path::PathBuf;
 
@@ -325,75 +324,11 @@ fn check(c: CheckArgs) -> Result<()> {
     Ok(())
 }
 
-/// The checks `thermal ramp` runs first: refuses (with every blocking finding) a log the
-/// ramp method cannot give a model from, prints the warnings on stderr.
-fn ramp_precheck(
-    log: &ImuLog,
-    path: &std::path::Path,
-    order: usize,
-    min_rise_c: f64,
-) -> Result<()> {
-    let opts = check_options(order, min_rise_c)?;
-    let r = check_log(log, &path.display().to_string(), &opts);
-    for f in r.findings.iter().filter(|f| f.ramp == Impact::Warn) {
-        eprintln!("warning: {}", f.message);
+/// Prints the warnings of a check on stderr.
+fn warn_all(warnings: &[String]) {
+    for w in warnings {
+        eprintln!("warning: {w}");
     }
-    let blocking = r.blocking(true);
-    if !blocking.is_empty() {
-        anyhow::bail!(
-            "the ramp method cannot give a model from this log:\n  {}\n(`driftless thermal \
-             check` prints the full report; --min-rise lowers the rise required)",
-            blocking
-                .iter()
-                .map(|f| f.message.as_str())
-                .collect::<Vec<_>>()
-                .join("\n  ")
-        );
-    }
-    Ok(())
-}
-
-/// The checks `thermal soak` runs first: the set temperatures of the manifest must span
-/// `min_rise_c`; the log's temperature, when it has one, must be finite; gaps are
-/// warned about. The positions come from the manifest, so plateau and orientation
-/// findings of the log alone do not apply.
-fn soak_precheck(
-    log: &ImuLog,
-    path: &std::path::Path,
-    manifest: &ChamberManifest,
-    manifest_source: &str,
-    order: usize,
-    min_rise_c: f64,
-) -> Result<()> {
-    let opts = check_options(order, min_rise_c)?;
-    let steps = manifest.steps();
-    let (lo, hi) = steps
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), s| {
-            (a.min(s.0), b.max(s.0))
-        });
-    if !(hi - lo).is_finite() || hi - lo < min_rise_c {
-        anyhow::bail!(
-            "{}: set temperatures span {lo}–{hi} °C ({:.1} °C); a thermal model needs at \
-             least {min_rise_c} °C (add set points, or lower --min-rise)",
-            manifest_source,
-            hi - lo
-        );
-    }
-    if log.indices_of(Quantity::Temperature).is_empty() {
-        return Ok(());
-    }
-    let r = check_log(log, &path.display().to_string(), &opts);
-    for f in &r.findings {
-        match f.kind {
-            FindingKind::NoData | FindingKind::BadTemperature => anyhow::bail!("{}", f.message),
-            FindingKind::Gaps | FindingKind::CoarseResolution => {
-                eprintln!("warning: {}", f.message)
-            }
-            _ => {}
-        }
-    }
-    Ok(())
 }
 
 fn soak(s: SoakArgs) -> Result<()> {
@@ -415,36 +350,24 @@ fn soak(s: SoakArgs) -> Result<()> {
     input.time_column.get_or_insert_with(|| "1".into());
     let log = input.read(&s.log)?;
     let (manifest, segmentation) = soak_manifest(&s, &log)?;
-    let pick = |q: Quantity, what: &str| -> Result<[&[f64]; 3]> {
-        log.triad_of(q).ok_or_else(|| {
-            anyhow::anyhow!(
-                "{}: needs three {what} columns with units (found {})",
-                s.log.display(),
-                log.indices_of(q).len()
-            )
-        })
-    };
-    let gyro = pick(Quantity::AngularRate, "angular-rate")?;
-    let accel = pick(Quantity::SpecificForce, "specific-force")?;
     let manifest_source = match &s.manifest {
         Some(p) => p.display().to_string(),
         None => format!("{} (plateaus found in the log)", s.log.display()),
     };
-    soak_precheck(
+    let log_name = s.log.display().to_string();
+    let check = check_options(s.order, s.min_rise)?;
+    warn_all(&soak_precheck(
         &log,
-        &s.log,
+        &log_name,
         &manifest,
         &manifest_source,
-        s.order,
-        s.min_rise,
-    )?;
+        &check,
+    )?);
     let fit_opts = FitOptions {
         order: s.order,
         t_ref_c: s.t_ref,
         ..FitOptions::default()
     };
-    let six = SixPositionOptions::from_manifest(&manifest);
-    let t = std::time::Instant::now();
     let drift = match &s.noise_model {
         Some(p) => {
             let m = driftless::allan::noise_model::NoiseModel::load(p)?;
@@ -455,27 +378,23 @@ fn soak(s: SoakArgs) -> Result<()> {
         }
         None => None,
     };
-    let soak = soak_calibration(&manifest, accel, gyro, 1.0, &six, &fit_opts, drift.as_ref())?;
-    // A model id from the coefficients (stable for the same fit; < 2⁶³: TOML integers
-    // are signed 64-bit).
-    let id = soak
-        .series
-        .iter()
-        .flat_map(|x| x.fit.coeffs.iter())
-        .fold(0xcbf2_9ce4_8422_2325u64, |h, c| {
-            (h ^ c.to_bits()).wrapping_mul(0x0100_0000_01b3)
-        })
-        >> 1;
-    let model = soak.compensation_model(id, policy)?;
-    let secs = t.elapsed().as_secs_f64();
+    let run = run_soak(
+        &log,
+        &log_name,
+        &manifest,
+        &fit_opts,
+        drift.as_ref(),
+        policy,
+    )?;
+    let (soak, model, id, secs) = (&run.soak, &run.model, run.model_id, run.seconds);
     if let Some(p) = &s.out {
-        ThermalModelFile::from_model(&model, ["m/s^2", "rad/s"]).save(p)?;
+        ThermalModelFile::from_model(model, ["m/s^2", "rad/s"]).save(p)?;
     }
     if let Some(p) = &s.plot {
         driftless::report::thermal_plot::write_thermal_plot(
             p,
             &format!("soak calibration of {}", s.log.display()),
-            &soak,
+            soak,
             [
                 ("bias (mg)", 1e3 / 9.80665),
                 ("bias (deg/s)", 180.0 / std::f64::consts::PI),
@@ -483,6 +402,21 @@ fn soak(s: SoakArgs) -> Result<()> {
         )
         .with_context(|| format!("writing {}", p.display()))?;
     }
+    if s.json {
+        return print_soak_json(&s, soak, id, segmentation, secs);
+    }
+    print_soak_human(&s, soak, secs);
+    Ok(())
+}
+
+/// The `--json` document of a soak calibration.
+fn print_soak_json(
+    s: &SoakArgs,
+    soak: &driftless::thermal::soak::SoakCalibration,
+    id: u64,
+    segmentation: Option<serde_json::Value>,
+    secs: f64,
+) -> Result<()> {
     let g_json = |g: &driftless::calib::six_position::GSensitivityEstimate| {
         serde_json::json!({
             "matrix": g.matrix_raw_per_m_s2.0,
@@ -490,46 +424,49 @@ fn soak(s: SoakArgs) -> Result<()> {
         })
     };
     let g_mean = soak.gyro_g_sensitivity_mean();
-    if s.json {
-        let g_steps: Vec<Option<serde_json::Value>> = soak
-            .gyro_g_sensitivity
-            .iter()
-            .map(|g| g.as_ref().map(g_json))
-            .collect();
-        let g_mean = g_mean.as_ref().map(g_json);
-        let series: Vec<serde_json::Value> = soak
-            .series
-            .iter()
-            .map(|x| {
-                serde_json::json!({
-                    "triad": x.triad, "quantity": x.quantity, "axis": (["x", "y", "z"][x.axis]),
-                    "coefficients": x.fit.coeffs, "std_errors": x.fit.std_errors,
-                    "residual_rms": x.fit.residual_rms, "chi2_per_dof": x.fit.chi2_per_dof,
-                    // √(χ²/dof) of the points against their σ, and the factor applied
-                    // to the σ (≥ 1: the bands follow the scatter seen)
-                    "scatter_ratio": x.fit.scatter_ratio, "sigma_scale": x.fit.sigma_scale,
-                })
+    let g_steps: Vec<Option<serde_json::Value>> = soak
+        .gyro_g_sensitivity
+        .iter()
+        .map(|g| g.as_ref().map(g_json))
+        .collect();
+    let g_mean = g_mean.as_ref().map(g_json);
+    let series: Vec<serde_json::Value> = soak
+        .series
+        .iter()
+        .map(|x| {
+            serde_json::json!({
+                "triad": x.triad, "quantity": x.quantity, "axis": (["x", "y", "z"][x.axis]),
+                "coefficients": x.fit.coeffs, "std_errors": x.fit.std_errors,
+                "residual_rms": x.fit.residual_rms, "chi2_per_dof": x.fit.chi2_per_dof,
+                // √(χ²/dof) of the points against their σ, and the factor applied
+                // to the σ (≥ 1: the bands follow the scatter seen)
+                "scatter_ratio": x.fit.scatter_ratio, "sigma_scale": x.fit.sigma_scale,
             })
-            .collect();
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::json!({
-                "temperatures_c": soak.temperatures_c,
-                "t_ref_c": s.t_ref,
-                "order": s.order,
-                "model_id": id,
-                "series": series,
-                // per step (order of temperatures_c), raw gyro units per m/s²; null when
-                // not estimated
-                "gyro_g_sensitivity": g_steps,
-                "gyro_g_sensitivity_mean": g_mean,
-                // the log's own segmentation when there was no manifest
-                "segmentation": segmentation,
-                "seconds": secs,
-            }))?
-        );
-        return Ok(());
-    }
+        })
+        .collect();
+    outln!(
+        "{}",
+        serde_json::to_string_pretty(&serde_json::json!({
+            "temperatures_c": soak.temperatures_c,
+            "t_ref_c": s.t_ref,
+            "order": s.order,
+            "model_id": id,
+            "series": series,
+            // per step (order of temperatures_c), raw gyro units per m/s²; null when
+            // not estimated
+            "gyro_g_sensitivity": g_steps,
+            "gyro_g_sensitivity_mean": g_mean,
+            // the log's own segmentation when there was no manifest
+            "segmentation": segmentation,
+            "seconds": secs,
+        }))?
+    );
+    Ok(())
+}
+
+/// The tables of a soak calibration.
+fn print_soak_human(s: &SoakArgs, soak: &driftless::thermal::soak::SoakCalibration, secs: f64) {
+    let g_mean = soak.gyro_g_sensitivity_mean();
     outln!(
         "{} set temperatures {:?} °C; order {} about {} °C; {:.3} s",
         soak.temperatures_c.len(),
@@ -583,7 +520,6 @@ fn soak(s: SoakArgs) -> Result<()> {
     for p in [&s.out, &s.plot].into_iter().flatten() {
         outln!("wrote {}", p.display());
     }
-    Ok(())
 }
 
 /// The manifest of `--manifest`, or without one the log's own segmentation (printed
@@ -606,49 +542,24 @@ fn soak_manifest(
 
 fn ramp(r: RampArgs) -> Result<()> {
     crate::paths::refuse_outputs_over_inputs(&[r.out.as_deref()], &[Some(&r.log)])?;
-    use driftless::thermal::ramp::{RampOptions, ramp_calibration};
     let mut input = r.input.clone();
     input.time_column.get_or_insert_with(|| "1".into());
     let log = input.read(&r.log)?;
-    let Some(time) = log.time_s.as_deref() else {
-        anyhow::bail!("{}: no time column", r.log.display());
-    };
-    ramp_precheck(&log, &r.log, r.order, r.min_rise)?;
-    let Some(temp) = log
-        .channels
-        .iter()
-        .find(|c| c.quantity == Quantity::Temperature)
-    else {
-        anyhow::bail!(
-            "{}: no temperature column (a column with unit degC, or `--column N:degC`)",
-            r.log.display()
-        );
-    };
-    let (t_lo, t_hi) = temp
-        .values
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-            (a.min(x), b.max(x))
-        });
+    let log_name = r.log.display().to_string();
+    warn_all(&ramp_precheck(
+        &log,
+        &log_name,
+        &check_options(r.order, r.min_rise)?,
+    )?);
+    let input = RampInput::from_log(&log, &log_name)?;
+    let (t_lo, t_hi) = input.temperature_range_c();
     note!(
         "{}: {} samples over {:.1} s, temperature {t_lo:.2}–{t_hi:.2} °C (span {:.2} °C)",
         r.log.display(),
         log.len(),
-        time.last().copied().unwrap_or(0.0) - time.first().copied().unwrap_or(0.0),
+        input.span_s(),
         t_hi - t_lo
     );
-    let chans: Vec<(&str, &[f64])> = log
-        .channels
-        .iter()
-        .filter(|c| matches!(c.quantity, Quantity::AngularRate | Quantity::SpecificForce))
-        .map(|c| (c.name.as_str(), c.values.as_slice()))
-        .collect();
-    if chans.is_empty() {
-        anyhow::bail!(
-            "{}: no angular-rate or specific-force column with a unit",
-            r.log.display()
-        );
-    }
     let opts = RampOptions {
         bin_c: r.bin,
         fit: FitOptions {
@@ -658,38 +569,9 @@ fn ramp(r: RampArgs) -> Result<()> {
         },
         ..RampOptions::default()
     };
-    let res = ramp_calibration(time, &temp.values, &chans, &opts)
-        .with_context(|| format!("{}", r.log.display()))?;
-    let heating = res.points.iter().filter(|p| p.heating).count();
-    if let Some(p) = &r.out {
-        // x, y, z channel indices (into `chans`) of each triad, when it has exactly three.
-        let triad = |q: Quantity| -> Option<[usize; 3]> {
-            let idx: Vec<usize> = log
-                .channels
-                .iter()
-                .filter(|c| matches!(c.quantity, Quantity::AngularRate | Quantity::SpecificForce))
-                .enumerate()
-                .filter(|(_, c)| c.quantity == q)
-                .map(|(i, _)| i)
-                .collect();
-            <[usize; 3]>::try_from(idx).ok()
-        };
-        let (acc, gyr) = (triad(Quantity::SpecificForce), triad(Quantity::AngularRate));
-        if acc.is_none() && gyr.is_none() {
-            anyhow::bail!(
-                "{}: --out needs three gyro or three accelerometer columns",
-                r.log.display()
-            );
-        }
-        let id = res
-            .fits
-            .iter()
-            .flat_map(|f| f.coeffs.iter())
-            .fold(0xcbf2_9ce4_8422_2325u64, |h, c| {
-                (h ^ c.to_bits()).wrapping_mul(0x0100_0000_01b3)
-            })
-            >> 1;
-        let file = res.bias_model_file(acc, gyr, id)?;
+    let run = run_ramp(&input, &opts, r.out.is_some())?;
+    let (res, heating) = (&run.result, run.heating_bins);
+    if let (Some(p), Some(file)) = (&r.out, &run.model_file) {
         // Refuse to write what `compensate` and `export` would not read.
         file.model(&p.display().to_string())?;
         file.save(p)?;

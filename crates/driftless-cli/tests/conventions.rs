@@ -577,3 +577,99 @@ fn simulate_write_chooses_the_output_families() {
     assert!(stderr_of(&o).contains("no [gnss]"), "{}", stderr_of(&o));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The `*_cmd` modules of the binary's sources (`foo_cmd.rs` and `foo_cmd/…`), each
+/// with its files' text.
+fn command_modules() -> Vec<(String, Vec<(PathBuf, String)>)> {
+    fn files_under(p: &Path, out: &mut Vec<(PathBuf, String)>) {
+        if p.is_dir() {
+            let mut entries: Vec<PathBuf> = std::fs::read_dir(p)
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .collect();
+            entries.sort();
+            for e in entries {
+                files_under(&e, out);
+            }
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push((p.to_path_buf(), std::fs::read_to_string(p).unwrap()));
+        }
+    }
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut modules: Vec<(String, Vec<(PathBuf, String)>)> = Vec::new();
+    for e in std::fs::read_dir(&src).unwrap() {
+        let p = e.unwrap().path();
+        let stem = p.file_stem().unwrap().to_string_lossy().into_owned();
+        if !stem.ends_with("_cmd") {
+            continue;
+        }
+        let i = match modules.iter().position(|(m, _)| *m == stem) {
+            Some(i) => i,
+            None => {
+                modules.push((stem, Vec::new()));
+                modules.len() - 1
+            }
+        };
+        files_under(&p, &mut modules[i].1);
+    }
+    modules.sort_by(|a, b| a.0.cmp(&b.0));
+    modules
+}
+
+/// The `*_cmd` modules a source text names through `crate::` (`crate::foo_cmd`, or
+/// `foo_cmd` inside a `crate::{…}` group).
+fn cmd_modules_named(text: &str) -> Vec<String> {
+    let mut named = Vec::new();
+    let mut rest = text;
+    while let Some(at) = rest.find("crate::") {
+        rest = &rest[at + "crate::".len()..];
+        let path: String = if let Some(group) = rest.strip_prefix('{') {
+            group.chars().take_while(|&c| c != '}').collect()
+        } else {
+            rest.chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect()
+        };
+        for word in path.split(|c: char| !(c.is_alphanumeric() || c == '_')) {
+            if word.ends_with("_cmd") && !named.iter().any(|n| n == word) {
+                named.push(word.to_owned());
+            }
+        }
+    }
+    named
+}
+
+#[test]
+fn command_modules_do_not_import_each_other() {
+    // The scanner itself: it finds both spellings and nothing else.
+    assert_eq!(
+        cmd_modules_named("use crate::demo_cmd::spinner; crate::output::sci(1.0)"),
+        ["demo_cmd"]
+    );
+    assert_eq!(
+        cmd_modules_named("use crate::{input::InputArgs, allan_cmd::run};"),
+        ["allan_cmd"]
+    );
+    let modules = command_modules();
+    assert!(
+        modules.len() >= 10 && modules.iter().any(|(m, _)| m == "allan_cmd"),
+        "found only {:?}",
+        modules.iter().map(|(m, _)| m).collect::<Vec<_>>()
+    );
+    let mut offences = Vec::new();
+    for (module, files) in &modules {
+        for (path, text) in files {
+            for other in cmd_modules_named(text) {
+                if other != *module {
+                    offences.push(format!("{} uses crate::{other}", path.display()));
+                }
+            }
+        }
+    }
+    assert!(
+        offences.is_empty(),
+        "command modules share work through the library or a neutral CLI module, never \
+         through another command:\n{}",
+        offences.join("\n")
+    );
+}

@@ -14,6 +14,8 @@ pub mod export;
 pub mod fit;
 pub mod gmwm;
 pub mod lines;
+pub mod log_analysis;
+pub mod log_replicates;
 pub mod noise_model;
 pub mod phase;
 pub mod plausibility;

@@ -17,6 +17,7 @@
 //! * [`six_position`]: six-position accelerometer and rate-table gyro calibration with
 //!   covariances (Titterton & Weston §8; IEEE Std 1293).
 
+pub mod job;
 pub mod lsq;
 pub mod model_file;
 pub mod multi_position;

@@ -14,8 +14,11 @@ use serde::Serialize;
 
 use super::ExperimentError;
 use super::scenario::{ExperimentScenario, VehicleSource};
-use crate::allan::analysis::{AnalysisConfig, ChannelResult, analyse_channels};
+use crate::allan::analysis::{AnalysisConfig, ChannelResult};
 use crate::allan::fit::FitConfig;
+use crate::allan::log_analysis::{
+    ChannelSelection, LogAnalysisError, LogAnalysisOptions, NoiseMethod, analyse_log,
+};
 use crate::allan::noise_model::NoiseModel;
 use crate::allan::taus::TauSpec;
 use crate::eval::reference::reference_from_fixes;
@@ -357,35 +360,27 @@ pub fn analyse_static_log(log: &ImuLog) -> Result<NoiseStage, ExperimentError> {
             ),
         ));
     }
-    let inputs: Vec<(&str, Vec<&[f64]>)> = keep
-        .iter()
-        .map(|&i| {
-            let c = &log.channels[i];
-            let segs: Vec<&[f64]> = if log.segments.is_empty() {
-                vec![c.values.as_slice()]
-            } else {
-                log.segments.iter().map(|r| &c.values[r.clone()]).collect()
-            };
-            (c.name.as_str(), segs)
-        })
-        .collect();
-    let cfg = AnalysisConfig {
-        taus: TauSpec::Log(100),
-        ..AnalysisConfig::default()
-    };
-    let results = analyse_channels(&inputs, log.tau0_s, &cfg)
-        .map_err(|e| ExperimentError::stage("noise", e))?;
-    let quantities: Vec<Quantity> = keep.iter().map(|&i| log.channels[i].quantity).collect();
-    let model = NoiseModel::from_curves(
-        &log.source,
-        &results,
-        &quantities,
+    let opts = LogAnalysisOptions {
+        analysis: AnalysisConfig {
+            taus: TauSpec::Log(100),
+            ..AnalysisConfig::default()
+        },
         // The IEEE 952 terms: the filter's bias states are their first-order stand-in,
         // and the simulated sensors of a study carry exactly these terms.
-        &FitConfig::IEEE_952,
-        cfg.confidence,
-    )
-    .map_err(|e| ExperimentError::stage("noise", e))?;
+        method: Some(NoiseMethod::Allan(FitConfig::IEEE_952, None)),
+        scale: None,
+        remove_lines: false,
+        resolution_from_data: false,
+        channels: ChannelSelection::Inertial,
+    };
+    let analysis = analyse_log(log, &opts).map_err(|e| match e {
+        LogAnalysisError::Curves { source, .. } => ExperimentError::stage("noise", source),
+        other => ExperimentError::stage("noise", other),
+    })?;
+    let (results, quantities) = (analysis.results, analysis.quantities);
+    let Some(model) = analysis.noise else {
+        return Err(ExperimentError::stage("noise", "no noise model was fitted"));
+    };
     Ok(NoiseStage {
         model,
         curves: Some(AllanCurves {

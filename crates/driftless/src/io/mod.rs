@@ -28,6 +28,7 @@ pub mod nav;
 mod number;
 pub mod output;
 pub mod probe;
+pub mod sim_writer;
 pub mod text;
 mod timing;
 #[cfg(feature = "autopilot-logs")]

@@ -22,6 +22,7 @@
 pub mod autopilot;
 pub mod check;
 pub mod fit;
+pub mod job;
 pub mod model_file;
 pub mod ramp;
 pub mod soak;
