@@ -40,6 +40,17 @@ pub fn check_samples(values: &[f64]) -> Result<(), AllanError> {
     Ok(())
 }
 
+/// τ0 = 1/rate for a positive, finite sample rate.
+pub fn sample_interval_s(rate_hz: f64) -> Result<f64, AllanError> {
+    if rate_hz.is_finite() && rate_hz > 0.0 {
+        Ok(1.0 / rate_hz)
+    } else {
+        Err(AllanError::Invalid(format!(
+            "rate must be a positive number of samples per second, got {rate_hz}"
+        )))
+    }
+}
+
 /// Deviations of `estimator` on `data` (phase, or rates when `is_frequency`) at the
 /// averaging factors `ms`, in allantools' form. Rates are integrated to phase with the
 /// mean removed (x₀ = 0, N+1 points), as allantools' `frequency2phase` does.
@@ -50,13 +61,8 @@ pub fn curve(
     is_frequency: bool,
     ms: &[usize],
 ) -> Result<CompatCurve, AllanError> {
-    if !(rate_hz.is_finite() && rate_hz > 0.0) {
-        return Err(AllanError::Invalid(format!(
-            "rate must be a positive number of samples per second, got {rate_hz}"
-        )));
-    }
+    let tau0_s = sample_interval_s(rate_hz)?;
     check_samples(data)?;
-    let tau0_s = 1.0 / rate_hz;
     let integrated;
     let phase: &[f64] = if is_frequency {
         integrated = frequency_to_phase(data, tau0_s);
