@@ -13,6 +13,7 @@ accelerometer channel, the fitted noise model.
 
 import json
 import math
+import numbers
 
 import numpy as np
 
@@ -24,6 +25,11 @@ __all__ = [
     "adev", "oadev", "mdev", "hdev", "ohdev", "tdev", "totdev",
     "analyse", "AnalysisResult", "NoiseModel", "simulate", "Simulation",
 ]
+
+
+def _positive_rate(rate):
+    return (isinstance(rate, numbers.Real) and not isinstance(rate, bool)
+            and math.isfinite(rate) and rate > 0)
 
 
 def _samples(data):
@@ -69,7 +75,7 @@ def _averaging_factors(taus, rate, n_phase):
 
 
 def _deviation(name, data, rate, data_type, taus):
-    if not (isinstance(rate, (int, float)) and math.isfinite(rate) and rate > 0):
+    if not _positive_rate(rate):
         raise ValueError(f"rate must be a positive number of samples per second, got {rate!r}")
     values = _samples(data)
     n_phase = len(values) + 1 if data_type == "freq" else len(values)
@@ -214,7 +220,7 @@ def analyse(data, rate, *, estimator="oadev", taus="log:100", data_type="freq",
     terms as ``driftless allan --fit`` takes them ("q,n,b,k,r,gm"; default: the IEEE 952
     terms and one Gauss-Markov term).
     """
-    if not (isinstance(rate, (int, float)) and math.isfinite(rate) and rate > 0):
+    if not _positive_rate(rate):
         raise ValueError(f"rate must be a positive number of samples per second, got {rate!r}")
     raw = _driftless.analyse_channel(
         _samples(data), float(rate), str(name), estimator, _tau_spec(taus), data_type,

@@ -85,6 +85,8 @@ def test_lists_and_float32_are_accepted_like_arrays():
     ours = driftless.oadev(x, rate=1.0, taus="decade")
     assert_same(ours, allantools.oadev(x.astype(np.float64), rate=1.0, taus="decade"), "float32")
     assert_same(driftless.oadev(list(map(float, x))), allantools.oadev(x.astype(float)), "list")
+    y = x.astype(float)
+    assert_same(driftless.oadev(y, rate=np.int64(4)), allantools.oadev(y, rate=4), "numpy rate")
 
 
 def test_bad_input_is_refused_with_the_reason():
