@@ -7,7 +7,7 @@
 //! The data types ([`ImuLog`], [`GnssFixes`], [`NavSolution`], [`TimeSpan`]), the crate's
 //! [`Error`] and [`Result`], and the entry point of each stage: [`read_log_file`];
 //! [`analyse`] / [`NoiseModel`]; [`calibrate_accel`] / [`calibrate_gyro`] and
-//! [`CalibrationFile`]; [`fit`] and [`ThermalModelFile`]; [`run_session`] (whose result
+//! [`CalibrationFile`]; [`fit()`] and [`ThermalModelFile`]; [`run_session`] (whose result
 //! [`SessionResult::smooth`]s itself) and [`run_kf_gins_job`]; [`horizontal_rms_m`];
 //! [`Scenario`].
 

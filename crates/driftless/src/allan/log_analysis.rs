@@ -25,7 +25,7 @@ use std::ops::Range;
 #[derive(Clone, Debug)]
 pub enum NoiseMethod {
     /// IEEE 952 term fit to the OADEV curve, over a user range (None: automatic,
-    /// [`super::fit::auto_fit_start`]).
+    /// [`super::fit::auto_range_candidates`]).
     Allan(FitConfig, Option<FitRangeSpec>),
     /// Generalized method of wavelet moments.
     Gmwm(GmwmConfig),

@@ -1,7 +1,7 @@
 //! Numerical helpers shared by every stage, one implementation each:
 //!
 //! * [`normal`] — erfc, the standard normal CDF Φ and its inverse Φ⁻¹;
-//! * [`cholesky`] — dense Cholesky factorisation, solves and inverse of small SPD
+//! * [`mod@cholesky`] — dense Cholesky factorisation, solves and inverse of small SPD
 //!   matrices (least squares, covariance whitening);
 //! * [`splitmix`] — the SplitMix64 mixer used to seed generators and derive sub-seeds;
 //! * [`order`] — medians of samples (sorting with `f64::total_cmp`, NaN-safe).
