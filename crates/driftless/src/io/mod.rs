@@ -6,6 +6,8 @@
 //! * [`write`](mod@write): CSV writer.
 //! * [`ulog`], [`dataflash`], [`autopilot`] (feature `autopilot-logs`, on by default): PX4
 //!   ULog and ArduPilot DataFlash logs → one [`log::ImuLog`] per IMU instance.
+//! * [`rosbag`]: ROS 1 bags and MCAP files (ROS 2) → the [`log::ImuLog`] of one
+//!   `sensor_msgs/Imu` topic.
 //! * [`units`]: unit strings → SI conversion.
 //! * [`error`]: one error type, [`LogError`], naming file, line and column.
 //! * [`input`]: an input opened once and sniffed on the handle that is then read (pipes
@@ -27,6 +29,7 @@ pub mod log {
 pub mod nav;
 mod number;
 pub mod output;
+pub mod rosbag;
 pub mod text;
 mod timing;
 #[cfg(feature = "autopilot-logs")]
@@ -49,6 +52,7 @@ pub use binary::{read_binary, read_binary_file, write_binary, write_binary_file}
 pub use error::{Location, LogError};
 pub use input::{InputFormat, LogInput, MAX_CONFIG_BYTES, read_config_text};
 pub use log::{Channel, ImuLog, Quantity, TimeGap};
+pub use rosbag::{BagFormat, read_rosbag_file};
 pub use text::{
     ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, TextOptions, read_text,
     read_text_bytes, read_text_file,

@@ -459,6 +459,17 @@ fn declared_rows(region: &[u8]) -> Option<(usize, bool)> {
     Some((n, marked))
 }
 
+/// The header of a EuRoC / TUM-VI IMU CSV (`#timestamp [ns],w_RS_S_x [rad s^-1],…,
+/// a_RS_S_z [m s^-2]`) without its `#`: a comment line by the rules above, taken as the
+/// header when it is the first line with content (its bracketed units then give ns time
+/// stamps, rad/s and m/s²).
+fn euroc_header(line: &[u8]) -> Option<&[u8]> {
+    let rest = line.trim_ascii_start().strip_prefix(b"#")?;
+    let is_euroc = rest.trim_ascii_start().starts_with(b"timestamp")
+        && rest.windows(8).any(|w| w == b"w_RS_S_x");
+    is_euroc.then_some(rest)
+}
+
 /// True when the line holds no data (blank or comment).
 #[inline]
 fn is_blank_or_comment(line: &[u8]) -> bool {
@@ -1321,12 +1332,13 @@ fn read_impl<R: Read>(
                             }),
                     );
                 }
-                if !is_blank_or_comment(line) {
+                let euroc = sample.is_empty().then(|| euroc_header(line)).flatten();
+                if let Some(text) = euroc.or((!is_blank_or_comment(line)).then_some(line)) {
                     starts.push(offset);
                     sample.push(SampleLine {
                         line: line_base + i,
                         end: offset + this_len,
-                        text: line,
+                        text,
                     });
                     if sample.len() > REFERENCE_SAMPLE + 2 {
                         break;

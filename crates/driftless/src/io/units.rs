@@ -141,7 +141,7 @@ impl fmt::Display for Unit {
 fn base_unit(u: &str) -> Option<(Quantity, f64, f64)> {
     use Quantity::*;
     Some(match u {
-        "rad/s" | "rps" => (AngularRate, 1.0, 0.0),
+        "rad/s" | "rps" | "rads^-1" | "rads-1" => (AngularRate, 1.0, 0.0),
         "deg/s" | "dps" | "°/s" => (AngularRate, k::DEG_PER_S, 0.0),
         "rad/h" | "rad/hr" => (AngularRate, 1.0 / k::HOUR_S, 0.0),
         "deg/h" | "deg/hr" | "°/h" | "dph" => (AngularRate, k::DEG_PER_H, 0.0),
