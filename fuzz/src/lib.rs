@@ -10,6 +10,7 @@ pub mod config_formats;
 pub mod dataflash_reader;
 pub mod log_input;
 pub mod nav_formats;
+pub mod rosbag_reader;
 pub mod text_reader;
 pub mod ulog_reader;
 
@@ -17,12 +18,13 @@ pub mod ulog_reader;
 pub type Harness = fn(&[u8]);
 
 /// Every target, by the name of its corpus folder and binary.
-pub const TARGETS: [(&str, Harness); 7] = [
+pub const TARGETS: [(&str, Harness); 8] = [
     ("binary_reader", binary_reader::run),
     ("config_formats", config_formats::run),
     ("dataflash_reader", dataflash_reader::run),
     ("log_input", log_input::run),
     ("nav_formats", nav_formats::run),
+    ("rosbag_reader", rosbag_reader::run),
     ("text_reader", text_reader::run),
     ("ulog_reader", ulog_reader::run),
 ];

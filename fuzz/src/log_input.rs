@@ -87,6 +87,8 @@ fn expected_format(body: &[u8]) -> InputFormat {
         InputFormat::Gzip
     } else if body.starts_with(driftless::io::binary::MAGIC) {
         InputFormat::Binary
+    } else if let Some(f) = driftless::io::rosbag::detect_format(&body[..body.len().min(8)]) {
+        InputFormat::RosBag(f)
     } else if body.starts_with(&ulog::MAGIC) {
         InputFormat::ULog
     } else if body.starts_with(&[dataflash::HEAD1, dataflash::HEAD2, 128]) {

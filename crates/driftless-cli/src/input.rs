@@ -14,6 +14,10 @@ pub struct InputArgs {
     /// IMU instance to take from a PX4 ULog (`.ulg`) or ArduPilot DataFlash (`.bin`) log.
     #[arg(long, value_name = "N", default_value_t = 0, value_parser = crate::numbers::whole::<u8>, allow_hyphen_values = true)]
     pub instance: u8,
+    /// `sensor_msgs/Imu` topic to take from a ROS 1 bag (`.bag`), an MCAP file or a ROS 2
+    /// bag folder (default: the bag's only IMU topic).
+    #[arg(long, value_name = "TOPIC")]
+    pub topic: Option<String>,
     /// Sample rate in Hz (required when the file has no time column).
     #[arg(long, value_name = "HZ", value_parser = crate::numbers::positive, allow_hyphen_values = true)]
     pub rate: Option<f64>,
@@ -107,8 +111,17 @@ impl InputArgs {
             return read_autopilot(input, self.instance);
         }
         let path = std::path::PathBuf::from(input.name());
-        let opts = self.text_options()?;
-        let log = input.read_log(&opts)?;
+        let log = if input.is_rosbag() {
+            input.read_rosbag(self.topic.as_deref())?
+        } else {
+            if let Some(t) = &self.topic {
+                anyhow::bail!(
+                    "{}: --topic {t} is for ROS bags and MCAP files; this input is not one",
+                    path.display()
+                );
+            }
+            input.read_log(&self.text_options()?)?
+        };
         if log.is_empty() {
             anyhow::bail!("{}: no data rows", path.display());
         }

@@ -225,3 +225,8 @@ fn text_reader() {
 fn ulog_reader() {
     replay("ulog_reader");
 }
+
+#[test]
+fn rosbag_reader() {
+    replay("rosbag_reader");
+}

@@ -137,7 +137,7 @@ impl ChannelResult {
 
 /// Analyse one channel given as one or more contiguous segments (segments come from
 /// splitting a log at time gaps; terms never straddle a gap).
-pub fn analyse_segments(
+pub(crate) fn analyse_segments(
     name: &str,
     segments: &[&[f64]],
     tau0_s: f64,

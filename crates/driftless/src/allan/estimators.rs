@@ -37,7 +37,7 @@ pub struct Sums {
 
 impl Sums {
     /// Combine two sums for the same m (e.g. from two gap-separated segments).
-    pub fn merge(self, other: Sums) -> Sums {
+    pub(crate) fn merge(self, other: Sums) -> Sums {
         debug_assert_eq!(self.m, other.m);
         Sums {
             m: self.m,

@@ -85,16 +85,16 @@ pub(crate) use solve::golden_max;
 use solve::{IrlsSolution, covariance, golden_max_tol, irls, upper_limit};
 
 /// (2 ln2/π): Allan variance of bias instability per B².
-pub const BIAS_AVAR_COEF: f64 = 2.0 * LN_2 / PI;
+pub(crate) const BIAS_AVAR_COEF: f64 = 2.0 * LN_2 / PI;
 /// √(2 ln2/π) ≈ 0.6643: the Allan-deviation floor per unit bias instability.
-pub const BIAS_ADEV_FLOOR: f64 = 0.664_282_470_267_960_1;
+pub(crate) const BIAS_ADEV_FLOOR: f64 = 0.664_282_470_267_960_1;
 
 /// Allan variance of a first-order Gauss-Markov process with stationary σ and
 /// correlation time T (IEEE Std 952-1997 Annex C, exponentially correlated noise):
 /// with u = τ/T: σ²_A(τ) = (σ²/u²)·(2u − 3 + 4e^{−u} − e^{−2u}), i.e. the
 /// standard (q_c²T²/τ)[1 − (T/2τ)(3 − 4e^{−τ/T} + e^{−2τ/T})] with q_c² = 2σ²/T.
 /// Small u behaves like rate random walk (2σ²u/3), large u like white noise (2σ²/u).
-pub fn gauss_markov_avar(sigma: f64, tau_c: f64, tau: f64) -> f64 {
+pub(crate) fn gauss_markov_avar(sigma: f64, tau_c: f64, tau: f64) -> f64 {
     let u = tau / tau_c;
     if u < 1e-3 {
         // series: 2u − 3 + 4e^{−u} − e^{−2u} = (2/3)u³ − (1/2)u⁴ + (7/30)u⁵ + O(u⁶)
@@ -105,7 +105,7 @@ pub fn gauss_markov_avar(sigma: f64, tau_c: f64, tau: f64) -> f64 {
 
 /// Location u* = τ/T and height of the maximum of the Gauss-Markov Allan variance per σ²:
 /// max_u (2u − 3 + 4e^{−u} − e^{−2u})/u² (found numerically: u* ≈ 1.8926, 0.38114).
-pub fn gauss_markov_avar_peak() -> (f64, f64) {
+pub(crate) fn gauss_markov_avar_peak() -> (f64, f64) {
     let g = |u: f64| gauss_markov_avar(1.0, 1.0, u);
     let (u, v) = golden_max(|lu: f64| g(lu.exp()), -3.0, 3.0);
     (u.exp(), v)

@@ -124,7 +124,7 @@ fn fft(re: &mut [f64], im: &mut [f64]) {
 
 /// Welch one-sided PSD of `y` sampled every `tau0_s` (module docs): (Δf, S_k for
 /// k = 0 … L/2). `None` for fewer than 8·64 samples.
-pub fn welch_psd(y: &[f64], tau0_s: f64, cfg: &LineConfig) -> Option<(f64, Vec<f64>)> {
+pub(crate) fn welch_psd(y: &[f64], tau0_s: f64, cfg: &LineConfig) -> Option<(f64, Vec<f64>)> {
     let n = y.len();
     let mut l = cfg.segment_len.next_power_of_two().max(64);
     while l > 64 && n < 8 * l {
@@ -336,7 +336,7 @@ impl ChannelLines {
 
 /// The largest relative increase of `with` over `without` (paired deviations at the same
 /// τ) and its τ: (max σ_with/σ_without − 1, τ).
-pub fn sigma_increase(tau: &[f64], with: &[f64], without: &[f64]) -> (f64, f64) {
+pub(crate) fn sigma_increase(tau: &[f64], with: &[f64], without: &[f64]) -> (f64, f64) {
     tau.iter()
         .zip(with.iter().zip(without))
         .filter(|(_, (a, b))| a.is_finite() && b.is_finite() && **b > 0.0)

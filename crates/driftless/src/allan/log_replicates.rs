@@ -61,7 +61,7 @@ pub struct ReplicateAnalysis {
 
 /// Whether the logs can be replicates of one sensor (the same channels, quantities and
 /// sample rate; [`check_same_sensor`]), checked before any analysis.
-pub fn check_replicate_logs(logs: &[(&str, &ImuLog)]) -> Result<(), ReplicateError> {
+pub(crate) fn check_replicate_logs(logs: &[(&str, &ImuLog)]) -> Result<(), ReplicateError> {
     let shapes: Vec<RunShape<'_>> = logs
         .iter()
         .map(|(name, log)| RunShape {
@@ -144,7 +144,7 @@ pub fn analyse_replicates(
 
 impl ReplicateAnalysis {
     /// Unit of each joint curve's channel (from the first run).
-    pub fn joint_units(&self) -> Vec<String> {
+    pub(crate) fn joint_units(&self) -> Vec<String> {
         match self.runs.first() {
             Some(r) => self
                 .replicates

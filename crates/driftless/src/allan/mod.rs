@@ -89,7 +89,7 @@ impl Estimator {
     }
 
     /// Whether the estimator is a Hadamard (third-difference) variance.
-    pub fn is_hadamard(self) -> bool {
+    pub(crate) fn is_hadamard(self) -> bool {
         matches!(self, Estimator::Hdev | Estimator::Ohdev)
     }
 }

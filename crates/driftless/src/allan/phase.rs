@@ -71,7 +71,7 @@ pub fn phase_to_frequency(x: &[f64], tau0: f64) -> Vec<f64> {
 }
 
 /// Mean of a slice with pairwise-blocked summation (accurate to ~1e-16 relative).
-pub fn mean_f64(v: &[f64]) -> f64 {
+pub(crate) fn mean_f64(v: &[f64]) -> f64 {
     if v.is_empty() {
         return 0.0;
     }

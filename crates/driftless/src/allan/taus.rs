@@ -174,7 +174,7 @@ fn log_spaced(n: usize, max_m: usize) -> Vec<usize> {
 }
 
 /// Phase points minus one (= frequency samples) the estimator needs for factor m.
-pub fn min_samples(estimator: Estimator, m: usize) -> usize {
+pub(crate) fn min_samples(estimator: Estimator, m: usize) -> usize {
     match estimator {
         Estimator::Adev | Estimator::Hdev => 5 * m,
         Estimator::Oadev | Estimator::Mdev | Estimator::Ohdev | Estimator::Tdev => 4 * m,

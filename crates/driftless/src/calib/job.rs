@@ -313,7 +313,7 @@ pub fn run_multi_position(
 /// Whether an accelerometer and a gyro log are sampled together: the same number of
 /// samples at the same instants (within half a sample interval) — a file's own time
 /// stamps are not set aside for its row order.
-pub fn check_sampled_together(
+pub(crate) fn check_sampled_together(
     accel: (&str, &ImuLog),
     gyro: (&str, &ImuLog),
 ) -> Result<(), CalibJobError> {

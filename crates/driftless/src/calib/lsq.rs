@@ -8,7 +8,7 @@
 use crate::numeric::{cholesky, cholesky_inverse, cholesky_solve};
 
 /// JᵀJ (n × n) and Jᵀr (n) of an m × n Jacobian and m residuals.
-pub fn normal_equations(j: &[f64], r: &[f64], m: usize, n: usize) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn normal_equations(j: &[f64], r: &[f64], m: usize, n: usize) -> (Vec<f64>, Vec<f64>) {
     let mut jtj = vec![0.0; n * n];
     let mut jtr = vec![0.0; n];
     for row in 0..m {

@@ -362,7 +362,7 @@ impl ChamberManifest {
 
     /// The manifest of step `segments` (a range from [`ChamberManifest::steps`]): the same
     /// site constants and time axis, only those segments.
-    pub fn step_manifest(&self, segments: Range<usize>) -> ChamberManifest {
+    pub(crate) fn step_manifest(&self, segments: Range<usize>) -> ChamberManifest {
         ChamberManifest {
             format_version: self.format_version,
             sample_rate_hz: self.sample_rate_hz,

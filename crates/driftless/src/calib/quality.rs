@@ -26,7 +26,12 @@ pub struct FitQuality {
 impl FitQuality {
     /// The figures, with a warning when χ²/ν exceeds `warn_chi2_per_dof`; `causes` lists
     /// the likely causes for this fit.
-    pub fn from_chi2(chi2: f64, dof: usize, warn_chi2_per_dof: f64, causes: &str) -> FitQuality {
+    pub(crate) fn from_chi2(
+        chi2: f64,
+        dof: usize,
+        warn_chi2_per_dof: f64,
+        causes: &str,
+    ) -> FitQuality {
         let chi2_per_dof = if dof > 0 { chi2 / dof as f64 } else { f64::NAN };
         let mut warnings = Vec::new();
         if chi2_per_dof > warn_chi2_per_dof {

@@ -47,7 +47,7 @@ pub enum Orientation {
 /// Orientation of an accelerometer reading `f` (specific force, any units, offset
 /// removed): the axis j with the largest |f_j| when the angle between f and ±e_j is at
 /// most `tolerance_deg`, else [`Orientation::Other`].
-pub fn classify_orientation(f: Vec3, tolerance_deg: f64) -> Orientation {
+pub(crate) fn classify_orientation(f: Vec3, tolerance_deg: f64) -> Orientation {
     let n = norm(f);
     if !(n > 0.0 && n.is_finite()) {
         return Orientation::Other;
@@ -169,7 +169,7 @@ fn variance_magnitude(v: Vec3) -> f64 {
 }
 
 /// ς(t) and ς_init of an accelerometer log (module equations).
-pub fn variance_profile(
+pub(crate) fn variance_profile(
     time_s: &[f64],
     accel_raw: &[Vec3],
     opts: &StaticDetectOptions,
@@ -229,7 +229,7 @@ pub fn variance_profile(
 }
 
 /// Static intervals from a precomputed [`VarianceProfile`] at threshold multiple `k`.
-pub fn intervals_from_profile(
+pub(crate) fn intervals_from_profile(
     profile: &VarianceProfile,
     time_s: &[f64],
     accel_raw: &[Vec3],

@@ -16,7 +16,7 @@ pub mod quality {
     /// Code-differential (DGPS/DGNSS).
     pub const DGPS: u8 = 4;
     /// Single point positioning.
-    pub const SINGLE: u8 = 5;
+    pub(crate) const SINGLE: u8 = 5;
     /// Precise point positioning.
     pub const PPP: u8 = 6;
 }
@@ -110,7 +110,7 @@ pub struct NavSolution {
 
 impl NavSolution {
     /// Append one epoch (every column grows by one).
-    pub fn push_epoch(
+    pub(crate) fn push_epoch(
         &mut self,
         time_s: f64,
         lat_rad: f64,

@@ -159,7 +159,7 @@ pub struct DynamicsSignals {
 /// Smoothed speed, longitudinal acceleration and yaw rate (module docs). `yaw_rad` may
 /// hold NaN where the heading is unknown. Columns of equal length, times increasing
 /// (not checked here: [`classify`] validates a whole trajectory).
-pub fn dynamics_signals(
+pub(crate) fn dynamics_signals(
     time_s: &[f64],
     vel_ned_m_s: &[[f64; 3]],
     yaw_rad: &[f64],
@@ -217,7 +217,7 @@ pub fn dynamics_signals(
 }
 
 /// The class of each epoch from its signals (the rules of the module docs).
-pub fn classify_signals(s: &DynamicsSignals, thr: &DynamicsThresholds) -> Vec<Dynamics> {
+pub(crate) fn classify_signals(s: &DynamicsSignals, thr: &DynamicsThresholds) -> Vec<Dynamics> {
     s.speed_m_s
         .iter()
         .zip(&s.long_accel_m_s2)
@@ -278,7 +278,7 @@ impl ClassMix {
     }
 
     /// Mix from per-class counts (index order of [`Dynamics::ALL`]).
-    pub fn from_counts(c: [usize; 5]) -> ClassMix {
+    pub(crate) fn from_counts(c: [usize; 5]) -> ClassMix {
         let n: usize = c.iter().sum();
         let f = |k: usize| if n == 0 { 0.0 } else { c[k] as f64 / n as f64 };
         ClassMix {

@@ -121,7 +121,7 @@ fn coast(start: &NavState, prev: &ImuIncrement, incs: &[ImuIncrement]) -> NavSta
 /// compensated increments) and `stream` (the increments the case fed the filter),
 /// against `reference`. `None` for an outage the records or the reference do not cover
 /// at the same epochs.
-pub fn outage_budgets(
+pub(crate) fn outage_budgets(
     windows: &[OutageWindow],
     reference: &NavSolution,
     epochs: &[EpochRecord],
@@ -195,7 +195,7 @@ pub enum ReversalCause {
 
 impl ReversalCause {
     /// One sentence for reports.
-    pub fn explanation(self) -> &'static str {
+    pub(crate) fn explanation(self) -> &'static str {
         match self {
             ReversalCause::Tie => "a tie: the end errors agree to within 5 %",
             ReversalCause::StartState => {
@@ -243,7 +243,12 @@ pub struct Reversal {
 }
 
 /// The cause of a reversal of `x` over `y` (end errors `ex` > `ey`).
-pub fn reversal_cause(ex: f64, ey: f64, x: &OutageBudget, y: &OutageBudget) -> ReversalCause {
+pub(crate) fn reversal_cause(
+    ex: f64,
+    ey: f64,
+    x: &OutageBudget,
+    y: &OutageBudget,
+) -> ReversalCause {
     if ex - ey <= TIE_FRACTION * ey {
         return ReversalCause::Tie;
     }
@@ -357,7 +362,7 @@ pub struct ReversalCount {
 }
 
 /// Reversal counts over runs, for each pair of cases of different rank.
-pub fn reversal_counts(runs: &[VehicleRun]) -> Vec<ReversalCount> {
+pub(crate) fn reversal_counts(runs: &[VehicleRun]) -> Vec<ReversalCount> {
     let Some(first) = runs.first() else {
         return Vec::new();
     };

@@ -28,7 +28,7 @@ use super::run::{
 impl ExperimentResult {
     /// Per case (run 0's order): label and each run's mean end-of-outage horizontal
     /// error of the forward filter (`None` where the case failed).
-    pub fn per_run_forward_means(&self) -> Vec<(String, Vec<Option<f64>>)> {
+    pub(crate) fn per_run_forward_means(&self) -> Vec<(String, Vec<Option<f64>>)> {
         self.detailed
             .cases
             .iter()
@@ -94,7 +94,7 @@ impl Spread {
 }
 
 /// Percentile of sorted values, linear between order statistics (type 7).
-pub fn percentile(sorted: &[f64], q: f64) -> f64 {
+pub(crate) fn percentile(sorted: &[f64], q: f64) -> f64 {
     if sorted.is_empty() {
         return f64::NAN;
     }
@@ -187,7 +187,7 @@ pub struct MonteCarloSummary {
 }
 
 /// Percentile-bootstrap interval of mean(num)/mean(den) over paired runs.
-pub fn ratio_interval(
+pub(crate) fn ratio_interval(
     num: &[f64],
     den: &[f64],
     confidence: f64,
@@ -235,7 +235,7 @@ pub fn ratio_interval(
 }
 
 /// Statistics of the runs.
-pub fn summarise(runs: &[VehicleRun], confidence: f64, seed: u64) -> MonteCarloSummary {
+pub(crate) fn summarise(runs: &[VehicleRun], confidence: f64, seed: u64) -> MonteCarloSummary {
     let mut cases = Vec::new();
     let present: Vec<Case> = runs
         .first()

@@ -68,7 +68,7 @@ pub enum Case {
 impl Case {
     /// The cases an experiment processes: (a) and (b); (c) and (d) when there is a
     /// thermal model (its room calibration gives (d)). In table order.
-    pub fn processed(with_thermal_model: bool) -> Vec<Case> {
+    pub(crate) fn processed(with_thermal_model: bool) -> Vec<Case> {
         let mut c = vec![Case::Raw, Case::RoomBias];
         if with_thermal_model {
             c.push(Case::Thermal);
@@ -335,7 +335,7 @@ pub struct NoiseStage {
 
 /// Analyses a static log: OADEV on 100 log-spaced τ, the noise terms fitted (Q, N, B, K,
 /// R), 68.3 % intervals.
-pub fn analyse_static_log(log: &ImuLog) -> Result<NoiseStage, ExperimentError> {
+pub(crate) fn analyse_static_log(log: &ImuLog) -> Result<NoiseStage, ExperimentError> {
     let keep: Vec<usize> = (0..log.channels.len())
         .filter(|&i| {
             matches!(

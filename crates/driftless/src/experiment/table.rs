@@ -138,7 +138,7 @@ fn failed_cell(run: &VehicleRun, c: Case, col: Column) -> String {
 }
 
 /// Metres (or degrees) with sensible digits: 3 significant below 100, whole units above.
-pub fn fmt_m(v: f64) -> String {
+pub(crate) fn fmt_m(v: f64) -> String {
     if !v.is_finite() {
         "n/a".into()
     } else if v.abs() >= 100.0 {
@@ -195,9 +195,9 @@ pub fn csv(header: &[String], rows: &[Vec<String>]) -> String {
 
 /// The paper's reference figures (Table 1 means): column 2, without scale factor and
 /// thermal compensation models, m.
-pub const PAPER_MEAN_ROOM_M: f64 = 1254.2;
+pub(crate) const PAPER_MEAN_ROOM_M: f64 = 1254.2;
 /// The paper's mean with the thermal model, m.
-pub const PAPER_MEAN_THERMAL_M: f64 = 150.1361;
+pub(crate) const PAPER_MEAN_THERMAL_M: f64 = 150.1361;
 
 /// One case of the detailed run, for the JSON document.
 #[derive(Serialize)]
@@ -284,7 +284,7 @@ impl<'a> ExperimentDocument<'a> {
 
 /// Bias change the thermal model predicts between two temperatures: largest |Δb| over
 /// the gyro axes (rad/s) and over the accelerometer axes (m/s²).
-pub fn thermal_bias_change(
+pub(crate) fn thermal_bias_change(
     model: &driftless_model::compensation::CompensationModel,
     t0_c: f64,
     t1_c: f64,

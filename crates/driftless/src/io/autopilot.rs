@@ -14,7 +14,7 @@
 //!   silent NaN.
 
 use super::error::{Location, LogError};
-use super::log::{Channel, ImuLog, Quantity, TimeGap};
+use super::log::{Channel, ImuLog, Quantity};
 
 /// Which autopilot log format a byte buffer holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -152,7 +152,7 @@ impl Scalar {
     }
 
     /// Decodes the value at the start of `b` as f64; `None` when `b` is too short.
-    pub fn read_f64(self, b: &[u8]) -> Option<f64> {
+    pub(crate) fn read_f64(self, b: &[u8]) -> Option<f64> {
         use Scalar::*;
         Some(match self {
             I8 => f64::from(*b.first()? as i8),
@@ -278,14 +278,7 @@ pub(crate) fn build_imu_log(
         }
     };
     super::timing::check_one_rate(&time_s, 1.5 * tau0_s, source)?;
-    let gaps: Vec<TimeGap> = (1..time_s.len())
-        .filter(|&i| time_s[i] - time_s[i - 1] > 1.5 * tau0_s)
-        .map(|i| TimeGap {
-            index: i,
-            start_s: time_s[i - 1],
-            duration_s: time_s[i] - time_s[i - 1],
-        })
-        .collect();
+    let gaps = super::timing::gaps_over(&time_s, 1.5 * tau0_s);
     let channels = columns
         .into_iter()
         .map(|c| Channel {

@@ -51,7 +51,7 @@ pub const HEAD1: u8 = 0xA3;
 /// Second byte of every message header.
 pub const HEAD2: u8 = 0x95;
 /// Message type of FMT.
-pub const FMT_TYPE: u8 = 128;
+pub(crate) const FMT_TYPE: u8 = 128;
 const FMT_LENGTH: usize = 89;
 const FORMAT: &str = "ArduPilot DataFlash";
 
@@ -173,7 +173,7 @@ impl DataFlash {
             .map_or(0, |r| r.offsets.len())
     }
     /// Byte offsets of the messages named `name`.
-    pub fn byte_offsets(&self, name: &str) -> Vec<u64> {
+    pub(crate) fn byte_offsets(&self, name: &str) -> Vec<u64> {
         self.format_by_name(name)
             .and_then(|f| self.rows.get(&f.type_id))
             .map_or_else(Vec::new, |r| r.offsets.clone())
@@ -202,7 +202,7 @@ impl DataFlash {
         )
     }
     /// A 64-bit unsigned field exactly (time stamps such as `TimeUS`).
-    pub fn column_u64(&self, message: &str, field: &str) -> Option<Vec<u64>> {
+    pub(crate) fn column_u64(&self, message: &str, field: &str) -> Option<Vec<u64>> {
         let (f, rows) = self.field(message, field)?;
         if f.kind != DfKind::Number(Scalar::U64, 1.0) {
             return None;
@@ -215,7 +215,7 @@ impl DataFlash {
         )
     }
     /// A text field (`n N Z`) of every `message`, NULs trimmed, lossy UTF-8.
-    pub fn text_column(&self, message: &str, field: &str) -> Option<Vec<String>> {
+    pub(crate) fn text_column(&self, message: &str, field: &str) -> Option<Vec<String>> {
         let (f, rows) = self.field(message, field)?;
         let DfKind::Text(n) = f.kind else {
             return None;

@@ -30,6 +30,8 @@ pub enum InputFormat {
     ULog,
     /// An ArduPilot DataFlash log (feature `autopilot-logs`).
     DataFlash,
+    /// A ROS 1 bag, an MCAP file or a ROS 2 sqlite3 bag ([`super::rosbag`]).
+    RosBag(super::rosbag::BagFormat),
 }
 
 /// An input file opened once, its first bytes already read. Every reader takes the bytes
@@ -46,7 +48,16 @@ pub struct LogInput {
 impl LogInput {
     /// Opens `path` and reads its first bytes. Errors name the file.
     pub fn open(path: impl AsRef<Path>) -> Result<LogInput, LogError> {
-        let path = path.as_ref();
+        let mut path = path.as_ref();
+        // A ROS 2 bag is a folder: its metadata.yaml and one storage file.
+        let storage = if path.is_dir() {
+            super::rosbag::storage_file_in(path)?
+        } else {
+            None
+        };
+        if let Some(p) = &storage {
+            path = p;
+        }
         let name = path.display().to_string();
         let io = |error| LogError::Io {
             path: name.clone(),
@@ -97,6 +108,7 @@ impl LogInput {
                 let stream = Cursor::new(self.head).chain(self.file);
                 read_gzip(stream, &self.name, opts)
             }
+            InputFormat::RosBag(_) => self.read_rosbag(None),
             f @ (InputFormat::ULog | InputFormat::DataFlash) => Err(LogError::InvalidOptions {
                 at: Location::input(&self.name),
                 message: format!(
@@ -135,6 +147,17 @@ impl LogInput {
         Ok(bytes)
     }
 
+    /// Whether the input is a ROS bag or MCAP file (by its magic bytes).
+    pub fn is_rosbag(&self) -> bool {
+        matches!(self.format(), InputFormat::RosBag(_))
+    }
+
+    /// Reads the IMU topic `topic` of a ROS bag or MCAP file (without one, its only IMU
+    /// topic); see [`super::rosbag`].
+    pub fn read_rosbag(self, topic: Option<&str>) -> Result<ImuLog, LogError> {
+        super::rosbag::read_rosbag(self.file, &self.name, topic)
+    }
+
     /// Whether the input is a PX4 ULog or ArduPilot DataFlash log (by its magic bytes).
     pub fn is_autopilot(&self) -> bool {
         matches!(self.format(), InputFormat::ULog | InputFormat::DataFlash)
@@ -168,6 +191,9 @@ fn sniff(head: &[u8]) -> InputFormat {
     }
     if head == super::binary::MAGIC {
         return InputFormat::Binary;
+    }
+    if let Some(f) = super::rosbag::detect_format(head) {
+        return InputFormat::RosBag(f);
     }
     #[cfg(feature = "autopilot-logs")]
     match super::autopilot::detect_format(head) {

@@ -6,6 +6,8 @@
 //! * [`write`](mod@write): CSV writer.
 //! * [`ulog`], [`dataflash`], [`autopilot`] (feature `autopilot-logs`, on by default): PX4
 //!   ULog and ArduPilot DataFlash logs → one [`log::ImuLog`] per IMU instance.
+//! * [`rosbag`]: ROS 1 bags and MCAP files (ROS 2) → the [`log::ImuLog`] of one
+//!   `sensor_msgs/Imu` topic.
 //! * [`units`]: unit strings → SI conversion.
 //! * [`error`]: one error type, [`LogError`], naming file, line and column.
 //! * [`input`]: an input opened once and sniffed on the handle that is then read (pipes
@@ -28,6 +30,7 @@ pub mod nav;
 mod number;
 pub mod output;
 pub mod probe;
+pub mod rosbag;
 pub mod sim_writer;
 pub mod text;
 mod timing;
@@ -51,6 +54,7 @@ pub use binary::{read_binary, read_binary_file, write_binary, write_binary_file}
 pub use error::{Location, LogError};
 pub use input::{InputFormat, LogInput, MAX_CONFIG_BYTES, read_config_text};
 pub use log::{Channel, ImuLog, Quantity, TimeGap};
+pub use rosbag::{BagFormat, read_rosbag_file};
 pub use text::{
     ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, TextOptions, read_text,
     read_text_bytes, read_text_file,
@@ -62,7 +66,10 @@ pub use write::{write_csv, write_csv_file};
 /// environment variable (default `../shared/data`, relative to the working directory —
 /// the repository root in the README's commands), then a relative path resolved against
 /// `base_dir` (the file's folder; empty for the working directory).
-pub fn resolve_data_path(p: &std::path::Path, base_dir: &std::path::Path) -> std::path::PathBuf {
+pub(crate) fn resolve_data_path(
+    p: &std::path::Path,
+    base_dir: &std::path::Path,
+) -> std::path::PathBuf {
     use std::path::PathBuf;
     let text = p.to_string_lossy();
     let p = if text.contains("${DRIFTLESS_DATA}") {

@@ -32,7 +32,7 @@ impl PathKind {
 
 /// The first line of `path` (with its line ending) read from at most `max_bytes` bytes,
 /// or `None` when the file cannot be opened or read.
-pub fn first_line(path: &Path, max_bytes: u64) -> Option<String> {
+pub(crate) fn first_line(path: &Path, max_bytes: u64) -> Option<String> {
     let f = std::fs::File::open(path).ok()?;
     let mut line = String::new();
     BufReader::new(f.take(max_bytes))

@@ -43,7 +43,7 @@ impl SimFamilies {
 }
 
 /// Every file [`write_simulation`] may write.
-pub const SIM_OUTPUT_FILES: [&str; 8] = [
+pub(crate) const SIM_OUTPUT_FILES: [&str; 8] = [
     "imu.csv",
     "imu.txt",
     "truth.nav",

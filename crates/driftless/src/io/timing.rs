@@ -118,6 +118,19 @@ pub(crate) fn check_one_rate(
     }
 }
 
+/// The intervals of `t` longer than `limit_s`, as [`TimeGap`](super::log::TimeGap)s (for
+/// the readers that list gaps but keep one segment: autopilot logs, ROS bags).
+pub(crate) fn gaps_over(t: &[f64], limit_s: f64) -> Vec<super::log::TimeGap> {
+    (1..t.len())
+        .filter(|&i| t[i] - t[i - 1] > limit_s)
+        .map(|i| super::log::TimeGap {
+            index: i,
+            start_s: t[i - 1],
+            duration_s: t[i] - t[i - 1],
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -122,7 +122,7 @@ impl Topic {
         self.fields.iter().map(|f| f.name.as_str())
     }
     /// Byte offset in the file of row `i`'s data message.
-    pub fn row_byte_offset(&self, i: usize) -> Option<u64> {
+    pub(crate) fn row_byte_offset(&self, i: usize) -> Option<u64> {
         self.row_offsets.get(i).copied()
     }
     /// A field as f64 for every row (`None` when the topic has no such field). Floats are

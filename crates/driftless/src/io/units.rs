@@ -27,7 +27,7 @@ use driftless_model::units as k;
 use super::log::Quantity;
 
 /// The unit strings accepted, for error messages.
-pub const KNOWN_UNITS: &str = "rad/s, deg/s, rad/h, deg/h, m/s^2, g, mg, ug, degC, K, none, \
+pub(crate) const KNOWN_UNITS: &str = "rad/s, deg/s, rad/h, deg/h, m/s^2, g, mg, ug, degC, K, none, \
      counts[-OFFSET][*SCALE|/DIVISOR][UNIT] (e.g. counts-32768*0.00875deg/s)";
 
 /// A column's file unit and its conversion to SI: `si = (raw − offset_raw) × scale_si`.
@@ -113,7 +113,7 @@ impl Unit {
 
     /// Converts one raw file value to SI.
     #[inline]
-    pub fn to_si(&self, raw: f64) -> f64 {
+    pub(crate) fn to_si(&self, raw: f64) -> f64 {
         (raw - self.offset_raw) * self.scale_si
     }
 }
@@ -141,7 +141,7 @@ impl fmt::Display for Unit {
 fn base_unit(u: &str) -> Option<(Quantity, f64, f64)> {
     use Quantity::*;
     Some(match u {
-        "rad/s" | "rps" => (AngularRate, 1.0, 0.0),
+        "rad/s" | "rps" | "rads^-1" | "rads-1" => (AngularRate, 1.0, 0.0),
         "deg/s" | "dps" | "°/s" => (AngularRate, k::DEG_PER_S, 0.0),
         "rad/h" | "rad/hr" => (AngularRate, 1.0 / k::HOUR_S, 0.0),
         "deg/h" | "deg/hr" | "°/h" | "dph" => (AngularRate, k::DEG_PER_H, 0.0),

@@ -9,21 +9,21 @@
 use driftless_model::linalg::Vec3;
 
 /// Semi-major axis a, m.
-pub const A_M: f64 = 6_378_137.0;
+pub(crate) const A_M: f64 = 6_378_137.0;
 /// Flattening f.
 pub const F: f64 = 1.0 / 298.257_223_563;
 /// Semi-minor axis b = a(1 − f), m.
-pub const B_M: f64 = A_M * (1.0 - F);
+pub(crate) const B_M: f64 = A_M * (1.0 - F);
 /// First eccentricity squared e² = f(2 − f).
-pub const E2: f64 = F * (2.0 - F);
+pub(crate) const E2: f64 = F * (2.0 - F);
 /// Earth rotation rate ω_ie, rad/s.
 pub const OMEGA_IE: f64 = 7.292_115_146_7e-5;
 /// Earth gravitational constant GM, m³/s².
 pub const GM: f64 = 3.986_004_418e14;
 /// Normal gravity at the equator γ_e, m/s² (WGS-84).
-pub const GAMMA_E: f64 = 9.780_325_335_9;
+pub(crate) const GAMMA_E: f64 = 9.780_325_335_9;
 /// Somigliana constant k = (b·γ_p)/(a·γ_e) − 1 (WGS-84).
-pub const SOMIGLIANA_K: f64 = 0.001_931_852_652_41;
+pub(crate) const SOMIGLIANA_K: f64 = 0.001_931_852_652_41;
 
 /// Meridian (north–south) radius of curvature R_M(φ) = a(1 − e²)/(1 − e² sin²φ)^{3/2}.
 pub fn meridian_radius_m(lat_rad: f64) -> f64 {
@@ -57,13 +57,13 @@ pub fn gravity_ned(lat_rad: f64, height_m: f64) -> Vec3 {
 }
 
 /// Earth rotation rate resolved in NED: ω_ie^n = ω(cos φ, 0, −sin φ).
-pub fn earth_rate_ned(lat_rad: f64) -> Vec3 {
+pub(crate) fn earth_rate_ned(lat_rad: f64) -> Vec3 {
     [OMEGA_IE * lat_rad.cos(), 0.0, -OMEGA_IE * lat_rad.sin()]
 }
 
 /// Transport rate (rotation of NED relative to the Earth) in NED:
 /// ω_en^n = (v_E/(R_N + h), −v_N/(R_M + h), −v_E tan φ/(R_N + h)).
-pub fn transport_rate_ned(lat_rad: f64, height_m: f64, vel_ned_m_s: Vec3) -> Vec3 {
+pub(crate) fn transport_rate_ned(lat_rad: f64, height_m: f64, vel_ned_m_s: Vec3) -> Vec3 {
     let rm = meridian_radius_m(lat_rad) + height_m;
     let rn = prime_vertical_radius_m(lat_rad) + height_m;
     [

@@ -74,7 +74,7 @@ struct ClassSamples {
 const CHI2_1_MEDIAN: f64 = 0.454_936_423_119_572_8;
 
 /// Squared innovations beyond this many robust σ count as this many σ (winsorised).
-pub const CLIP_SIGMA: f64 = 10.0;
+pub(crate) const CLIP_SIGMA: f64 = 10.0;
 
 /// Batch covariance-matching floors (module docs) from a first pass's update outcomes.
 /// `used(t)` is false for fixes inside a convergence period. Classes are listed by

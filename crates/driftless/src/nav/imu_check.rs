@@ -109,7 +109,7 @@ impl ImuChannel {
     }
 
     /// True for the three gyro channels.
-    pub fn is_gyro(self) -> bool {
+    pub(crate) fn is_gyro(self) -> bool {
         (self as usize) < 3
     }
 
@@ -331,7 +331,7 @@ impl ImuCheckReport {
         self.findings.iter().filter(|f| f.kind == kind).count()
     }
     /// The findings of a kind.
-    pub fn of_kind(&self, kind: FindingKind) -> impl Iterator<Item = &ImuFinding> {
+    pub(crate) fn of_kind(&self, kind: FindingKind) -> impl Iterator<Item = &ImuFinding> {
         self.findings.iter().filter(move |f| f.kind == kind)
     }
     /// Findings replaced by [`repair_spikes`].
@@ -339,7 +339,7 @@ impl ImuCheckReport {
         self.findings.iter().filter(|f| f.repaired).count()
     }
     /// Non-physical findings not repaired: what [`refuse_non_physical`] refuses.
-    pub fn unrepaired_non_physical(&self) -> impl Iterator<Item = &ImuFinding> {
+    pub(crate) fn unrepaired_non_physical(&self) -> impl Iterator<Item = &ImuFinding> {
         self.of_kind(FindingKind::NonPhysical)
             .filter(|f| !f.repaired)
     }
@@ -566,7 +566,10 @@ pub fn check_imu(
 
 /// The error [`refuse_non_physical`] returns for the first unrepaired non-physical finding
 /// (`None` when there is none).
-pub fn non_physical_error(report: &ImuCheckReport, source_name: &str) -> Option<ImuCheckError> {
+pub(crate) fn non_physical_error(
+    report: &ImuCheckReport,
+    source_name: &str,
+) -> Option<ImuCheckError> {
     let mut it = report.unrepaired_non_physical();
     let first = it.next()?;
     let rest = it.count();

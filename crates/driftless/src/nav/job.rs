@@ -142,7 +142,7 @@ fn required(
 /// The IMU format: as configured, or detected (`auto`): a tag file given or `FILE.tag`
 /// beside the log → tagged CSV; a first line with a non-numeric field (a header) → rates
 /// CSV; otherwise KF-GINS increments.
-pub fn detect_imu_format(format: &str, file: &Path, tag_given: bool) -> ImuFormat {
+pub(crate) fn detect_imu_format(format: &str, file: &Path, tag_given: bool) -> ImuFormat {
     match format {
         "kfgins" => ImuFormat::Kfgins,
         "tagged-csv" => ImuFormat::TaggedCsv,
@@ -480,7 +480,7 @@ fn median_interval(imu: &ImuStream) -> f64 {
 /// `auto:NxL` outages: chosen on the GNSS fixes inside the IMU span (the only reference of
 /// a recorded run) before any filtering, so an impossible request fails at once; returned
 /// as absolute windows. Other specifications pass through unchanged.
-pub fn choose_outages(
+pub(crate) fn choose_outages(
     spec: OutageSpec,
     fixes: &GnssFixes,
 ) -> Result<(OutageSpec, Option<Vec<SelectedOutage>>), NavJobError> {

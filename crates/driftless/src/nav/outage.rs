@@ -42,40 +42,14 @@
 //! `end_s` is pure dead reckoning over the whole length `end_s − start_s` and the first
 //! fix used again lies strictly after `end_s`. The filter
 //! ([`crate::nav::filter::FilterConfig::outages_s`]), [`is_masked`], the session's
-//! evaluation and `crate::eval` all use this convention. See [`OutageWindow::contains`].
+//! evaluation and `crate::eval` all use this convention. See [`TimeSpan::contains`].
 
-use std::fmt;
 use std::str::FromStr;
 
-use serde::{Deserialize, Serialize};
-
-/// One outage in absolute GPS time (seconds of week of the GNSS data), half-open
-/// interval (start, end].
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct OutageWindow {
-    /// Start, GPS s of week: the last instant still aided (a fix exactly here is used).
-    pub start_s: f64,
-    /// End, GPS s of week (> `start_s`): the last withheld instant.
-    pub end_s: f64,
-}
-
-impl OutageWindow {
-    /// Length of the window, s.
-    pub fn duration_s(&self) -> f64 {
-        self.end_s - self.start_s
-    }
-    /// True when a GNSS epoch at `time_s` falls inside the window:
-    /// `start_s < time_s ≤ end_s`.
-    pub fn contains(&self, time_s: f64) -> bool {
-        time_s > self.start_s && time_s <= self.end_s
-    }
-}
-
-impl fmt::Display for OutageWindow {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "({} s, {} s]", self.start_s, self.end_s)
-    }
-}
+/// One outage in absolute GPS time (seconds of week of the GNSS data): the crate's
+/// interval type read as the half-open (start, end] — the fix at `start_s` is used, the
+/// fixes at `start_s < t ≤ end_s` are withheld ([`TimeSpan::contains`]).
+pub type OutageWindow = TimeSpan;
 
 /// Where a window's start is measured from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -124,28 +98,9 @@ pub enum OutageSpec {
     },
 }
 
-/// The GNSS time span outages are resolved against: first and last GNSS epoch, GPS s.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TimeSpan {
-    /// First GNSS epoch, GPS s of week.
-    pub start_s: f64,
-    /// Last GNSS epoch, GPS s of week.
-    pub end_s: f64,
-}
-
-impl TimeSpan {
-    /// Span of a sorted time column (`None` when empty).
-    pub fn of(time_s: &[f64]) -> Option<TimeSpan> {
-        Some(TimeSpan {
-            start_s: *time_s.first()?,
-            end_s: *time_s.last()?,
-        })
-    }
-    /// Length, s.
-    pub fn duration_s(&self) -> f64 {
-        self.end_s - self.start_s
-    }
-}
+/// The GNSS time span outages are resolved against: first and last GNSS epoch, GPS s
+/// ([`TimeSpan::of`] of the GNSS time column).
+pub use crate::data::TimeSpan;
 
 /// Why an outage specification was rejected.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -455,7 +410,7 @@ pub fn resolve(spec: &OutageSpec, span: TimeSpan) -> Result<Vec<OutageWindow>, O
 }
 
 /// True when `time_s` lies in any of `windows` (half-open (start, end], see
-/// [`OutageWindow::contains`]).
+/// [`TimeSpan::contains`]).
 pub fn is_masked(windows: &[OutageWindow], time_s: f64) -> bool {
     windows.iter().any(|w| w.contains(time_s))
 }

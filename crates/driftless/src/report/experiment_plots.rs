@@ -42,7 +42,7 @@ const OUTAGE_COLORS: [Color; 10] = [
 ];
 
 /// Colour and dash of outage `k` (0-based): unique for the first 30 outages.
-pub fn outage_style(k: usize) -> (Color, LineStyle) {
+pub(crate) fn outage_style(k: usize) -> (Color, LineStyle) {
     const STYLES: [LineStyle; 3] = [LineStyle::Solid, LineStyle::Dashed, LineStyle::Dotted];
     (
         OUTAGE_COLORS[k % OUTAGE_COLORS.len()],

@@ -566,7 +566,7 @@ impl ChamberConfig {
 
     /// Dwell of one visit of a static position, s: `position_dwell_s` over the visits
     /// per position of a step (2 per cycle palindromic, 1 sequential).
-    pub fn visit_dwell_s(&self) -> f64 {
+    pub(crate) fn visit_dwell_s(&self) -> f64 {
         let per_cycle = match self.step_order {
             StepOrder::Sequential => 1.0,
             StepOrder::Palindromic => 2.0,

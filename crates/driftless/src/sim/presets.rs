@@ -134,7 +134,7 @@ fn scaled(c: &[f64], unit: f64) -> Vec<f64> {
 ///   is an assumption): 0.305 mV/LSB, i.e. with 12.5 mV/(°/s) and 250 mV/g sensor
 ///   sensitivities 0.0244 °/s and 1.22 mg per LSB on rate samples. Increments: none (the
 ///   card samples rates). Temperature reported to 0.1 °C.
-pub fn adi_like() -> SensorConfig {
+pub(crate) fn adi_like() -> SensorConfig {
     let lsb_v = 20.0 / 65536.0;
     let gyro = GyroErrors {
         turn_on_bias_sigma_rad_s: [0.1 * DEG; 3],

@@ -71,13 +71,13 @@ impl Rng {
 
     /// Uniform on the open interval (0, 1) (safe to take `ln`).
     #[inline]
-    pub fn uniform_open(&mut self) -> f64 {
+    pub(crate) fn uniform_open(&mut self) -> f64 {
         ((self.next_u64() >> 11) as f64 + 0.5) * (1.0 / (1u64 << 53) as f64)
     }
 
     /// Uniform on [−1, 1).
     #[inline]
-    pub fn uniform_pm1(&mut self) -> f64 {
+    pub(crate) fn uniform_pm1(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 * (2.0 / (1u64 << 53) as f64) - 1.0
     }
 

@@ -746,7 +746,7 @@ impl Simulation {
 }
 
 /// Attitude of a truth state as Euler angles (for configs), rad.
-pub fn euler_of(q: &Quat) -> Euler {
+pub(crate) fn euler_of(q: &Quat) -> Euler {
     Euler::from_dcm(&q.to_dcm())
 }
 

@@ -39,7 +39,7 @@ pub struct AxisNoise {
 
 impl AxisNoise {
     /// The fitted terms of a noise fit (terms not fitted or not detected are zero).
-    pub fn from_fit(fit: &NoiseFit) -> AxisNoise {
+    pub(crate) fn from_fit(fit: &NoiseFit) -> AxisNoise {
         let v = |t: Option<crate::allan::fit::Term>| t.map_or(0.0, |t| t.value);
         AxisNoise {
             quantization: v(fit.quantization),
@@ -55,7 +55,7 @@ impl AxisNoise {
     }
 
     /// True when every term is zero.
-    pub fn is_zero(&self) -> bool {
+    pub(crate) fn is_zero(&self) -> bool {
         self.quantization == 0.0
             && self.white == 0.0
             && self.bias_instability == 0.0

@@ -316,12 +316,12 @@ impl TemperatureCurve {
     }
 
     /// Whether the temperature never changes.
-    pub fn is_constant(&self) -> bool {
+    pub(crate) fn is_constant(&self) -> bool {
         matches!(self.kind, Curve::Constant(_))
     }
 
     /// T at the times `first_s + k·dt_s`, k = 0 … out.len() − 1, into `out` (parallel).
-    pub fn sample_into(&self, first_s: f64, dt_s: f64, out: &mut [f64]) {
+    pub(crate) fn sample_into(&self, first_s: f64, dt_s: f64, out: &mut [f64]) {
         use rayon::prelude::*;
         if let Curve::Constant(v) = self.kind {
             out.fill(v);

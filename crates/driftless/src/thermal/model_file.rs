@@ -36,7 +36,7 @@ use driftless_model::thermal::ThermalPoly;
 pub const FORMAT_VERSION: u32 = 2;
 
 /// Oldest format version still read (1: no g-sensitivity).
-pub const OLDEST_FORMAT_VERSION: u32 = 1;
+pub(crate) const OLDEST_FORMAT_VERSION: u32 = 1;
 
 /// One triad of the file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

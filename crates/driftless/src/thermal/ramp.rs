@@ -289,7 +289,7 @@ impl RampCalibration {
     ///   calibrations likewise keep the accelerometer relative.
     ///
     /// Range: the temperatures of the bins; T_ref: the fits'; out of range: clamp.
-    pub fn bias_model_file(
+    pub(crate) fn bias_model_file(
         &self,
         accel: Option<[usize; 3]>,
         gyro: Option<[usize; 3]>,

@@ -45,7 +45,7 @@ fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
 }
 
 /// Regularized incomplete beta function I_x(a, b) for a, b > 0, 0 ≤ x ≤ 1.
-pub fn inc_beta(x: f64, a: f64, b: f64) -> f64 {
+pub(crate) fn inc_beta(x: f64, a: f64, b: f64) -> f64 {
     if x <= 0.0 {
         return 0.0;
     }
@@ -62,7 +62,7 @@ pub fn inc_beta(x: f64, a: f64, b: f64) -> f64 {
 }
 
 /// Student-t distribution function P(T_ν ≤ t), ν > 0 degrees of freedom.
-pub fn student_t_cdf(t: f64, dof: f64) -> f64 {
+pub(crate) fn student_t_cdf(t: f64, dof: f64) -> f64 {
     if t.is_nan() || dof.is_nan() || dof <= 0.0 {
         return f64::NAN;
     }
@@ -77,7 +77,7 @@ pub fn student_t_cdf(t: f64, dof: f64) -> f64 {
 ///
 /// E.g. `student_t_quantile(0.975, 10.0)` = 2.228 138 851 986 (the two-sided 95 %
 /// coverage factor with 10 degrees of freedom).
-pub fn student_t_quantile(p: f64, dof: f64) -> f64 {
+pub(crate) fn student_t_quantile(p: f64, dof: f64) -> f64 {
     if !(p > 0.0 && p < 1.0) || dof.is_nan() || dof <= 0.0 {
         return f64::NAN;
     }

@@ -86,7 +86,7 @@ fn ln_prefactor(a: f64, x: f64) -> f64 {
 ///
 /// The smaller of the two is computed directly, so both tails keep full relative
 /// precision.
-pub fn gamma_pq(a: f64, x: f64) -> (f64, f64) {
+pub(crate) fn gamma_pq(a: f64, x: f64) -> (f64, f64) {
     if x <= 0.0 {
         return (0.0, 1.0);
     }

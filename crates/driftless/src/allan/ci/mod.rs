@@ -76,7 +76,7 @@ pub fn edf(estimator: Estimator, alpha: i32, m: usize, n_phase: usize) -> f64 {
 /// M = 1 + ⌊(N − 1 − 2m)/stride⌋ terms, the count the strided estimator sums.
 ///
 /// `stride` is clamped to 1..=m, `alpha` to −2..=2; finite and ≥ 1 like [`edf`].
-pub fn edf_strided(alpha: i32, m: usize, stride: usize, n_phase: usize) -> f64 {
+pub(crate) fn edf_strided(alpha: i32, m: usize, stride: usize, n_phase: usize) -> f64 {
     let m = m.max(1);
     let stride = stride.clamp(1, m);
     let s = m as f64 / stride as f64;

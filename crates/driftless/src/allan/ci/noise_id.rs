@@ -14,7 +14,7 @@ pub const MIN_ACF_POINTS: usize = 30;
 /// decision margins (δ thresholds 0.25 apart), while an 18-h 100 Hz log would otherwise be
 /// re-read in full for every small averaging factor. Shorter series are used whole, so
 /// results on Stable32-sized data are unchanged.
-pub const MAX_ACF_POINTS: usize = 1 << 14;
+pub(crate) const MAX_ACF_POINTS: usize = 1 << 14;
 
 /// Fewest frequency averages the B1 ratio is used on (with 2 it is identically 1).
 pub const MIN_B1_POINTS: usize = 4;
@@ -132,7 +132,7 @@ pub fn acf_noise_id(x: &[f64], m: usize, dmax: u32) -> Option<NoiseId> {
 /// Barnes' B1(N, μ): expected ratio of the N-sample standard variance to the Allan
 /// variance for σ²_y(τ) ∝ τ^μ: N(1 − N^μ) / [2(N − 1)(1 − 2^μ)], μ = 0 limit
 /// N ln N / [2(N − 1) ln 2] (SP 1065 §5.6).
-pub fn b1_theory(n: f64, mu: f64) -> f64 {
+pub(crate) fn b1_theory(n: f64, mu: f64) -> f64 {
     if mu.abs() < 1e-12 {
         n * n.ln() / (2.0 * (n - 1.0) * std::f64::consts::LN_2)
     } else {

@@ -9,7 +9,7 @@ use super::{
 use crate::allan::noise_model::fmt_num;
 
 /// One mGal in m/s² (KF-GINS's accelerometer bias unit).
-pub const MILLIGAL: f64 = 1e-5;
+pub(crate) const MILLIGAL: f64 = 1e-5;
 
 /// A float as plain YAML 1.1 *and* 1.2 read it as a float: the shortest digits that read
 /// back to the same f64, always with a decimal point and a signed exponent

@@ -374,9 +374,9 @@ pub struct ExportOptions {
 }
 
 /// PX4 EKF2's default prediction period `EKF2_PREDICT_US` = 10 000 µs.
-pub const PX4_FILTER_RATE_HZ: f64 = 100.0;
+pub(crate) const PX4_FILTER_RATE_HZ: f64 = 100.0;
 /// ArduPilot EKF3's `EKF_TARGET_DT` = 0.012 s (the filter runs no faster).
-pub const ARDUPILOT_FILTER_RATE_HZ: f64 = 1.0 / 0.012;
+pub(crate) const ARDUPILOT_FILTER_RATE_HZ: f64 = 1.0 / 0.012;
 
 impl Default for ExportOptions {
     fn default() -> Self {
@@ -389,7 +389,7 @@ impl Default for ExportOptions {
 }
 
 /// The exportable values of one channel (see the module docs for the rules).
-pub fn axis_noise(ch: &ChannelNoise, sample_rate_hz: f64) -> AxisNoise {
+pub(crate) fn axis_noise(ch: &ChannelNoise, sample_rate_hz: f64) -> AxisNoise {
     let fit = &ch.fit;
     let channel = Some(ch.name.clone());
     let upper = |k: TermKind| {

@@ -106,7 +106,7 @@ impl Default for FitConfig {
 
 impl FitConfig {
     /// The linear terms switched on, in model order.
-    pub fn linear_terms(&self) -> Vec<TermKind> {
+    pub(crate) fn linear_terms(&self) -> Vec<TermKind> {
         let mut v = Vec::new();
         for (on, k) in [
             (self.quantization, TermKind::Quantization),

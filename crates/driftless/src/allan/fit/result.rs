@@ -36,7 +36,7 @@ impl TermKind {
 
     /// Allan variance per unit squared coefficient at `tau` (linear terms; the
     /// Gauss-Markov shape depends on T, see [`gauss_markov_avar`]).
-    pub fn basis(self, tau: f64) -> f64 {
+    pub(crate) fn basis(self, tau: f64) -> f64 {
         match self {
             TermKind::Quantization => 3.0 / (tau * tau),
             TermKind::White => 1.0 / tau,
@@ -248,7 +248,7 @@ impl NoiseFit {
     }
 
     /// Removes the fitted term of a kind from the values.
-    pub fn clear_term(&mut self, kind: TermKind) {
+    pub(crate) fn clear_term(&mut self, kind: TermKind) {
         match kind {
             TermKind::Quantization => self.quantization = None,
             TermKind::White => self.white = None,
@@ -272,7 +272,7 @@ impl NoiseFit {
     }
 
     /// The term contributing most Allan variance at `tau` (None if the model is empty).
-    pub fn dominant_term(&self, tau: f64) -> Option<TermKind> {
+    pub(crate) fn dominant_term(&self, tau: f64) -> Option<TermKind> {
         let mut best: Option<(TermKind, f64)> = None;
         let mut consider = |k: TermKind, v: f64| {
             if v > 0.0 && best.is_none_or(|(_, b)| v > b) {
@@ -297,7 +297,7 @@ impl NoiseFit {
     /// of each Allan point. A Gauss-Markov term behaves like random walk (α = −2) well
     /// below its correlation time, like white noise (α = 0) well above it and is given
     /// α = −1 in between (0.3 T … 3 T). Empty model: 0.
-    pub fn dominant_alpha(&self, tau: f64) -> i32 {
+    pub(crate) fn dominant_alpha(&self, tau: f64) -> i32 {
         match self.dominant_term(tau) {
             None => 0,
             Some(TermKind::GaussMarkov) => {

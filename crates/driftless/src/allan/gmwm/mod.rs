@@ -541,7 +541,7 @@ pub struct GmwmChannel {
 
 /// GMWM of several channels (each as its gap-free segments) in parallel; the error
 /// names the channel.
-pub fn gmwm_channels(
+pub(crate) fn gmwm_channels(
     channels: &[(&str, Vec<&[f64]>)],
     tau0_s: f64,
     cfg: &GmwmConfig,

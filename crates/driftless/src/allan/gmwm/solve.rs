@@ -36,7 +36,7 @@ impl Spec {
             .sum()
     }
 
-    pub fn n_gm(&self) -> usize {
+    pub(crate) fn n_gm(&self) -> usize {
         self.procs
             .iter()
             .filter(|p| **p == Process::GaussMarkov)
@@ -84,7 +84,7 @@ impl Spec {
 
     /// Sort the Gauss–Markov (ln σ², ln T) pairs of θ by increasing T (they are
     /// exchangeable; the order makes replicates comparable).
-    pub fn sort_gm(&self, th: &mut [f64]) {
+    pub(crate) fn sort_gm(&self, th: &mut [f64]) {
         let first = self.n_params() - 2 * self.n_gm();
         let mut pairs: Vec<(f64, f64)> = th[first..].chunks(2).map(|c| (c[0], c[1])).collect();
         pairs.sort_by(|a, b| a.1.total_cmp(&b.1));
@@ -343,7 +343,7 @@ impl Problem<'_> {
 
     /// `rounds` × (weights from the model at θ, LM from θ); returns θ and J with the
     /// weights of the final θ.
-    pub fn refine(&self, spec: &Spec, mut th: Vec<f64>, rounds: usize) -> (Vec<f64>, f64) {
+    pub(crate) fn refine(&self, spec: &Spec, mut th: Vec<f64>, rounds: usize) -> (Vec<f64>, f64) {
         for _ in 0..rounds {
             let w = self.weights(&self.model(spec, &th));
             th = self.lm(spec, &th, &w, 300).0;

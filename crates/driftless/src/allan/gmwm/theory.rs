@@ -61,30 +61,30 @@ fn sinh_minus_x(a: f64) -> f64 {
 }
 
 /// Haar WV of white noise with density `n` (u·√s) at averaging length `m` samples.
-pub fn wv_white(n: f64, m: f64, tau0_s: f64) -> f64 {
+pub(crate) fn wv_white(n: f64, m: f64, tau0_s: f64) -> f64 {
     n * n / (2.0 * m * tau0_s)
 }
 
 /// Haar WV of quantization noise Q (u·s).
-pub fn wv_quantization(q: f64, m: f64, tau0_s: f64) -> f64 {
+pub(crate) fn wv_quantization(q: f64, m: f64, tau0_s: f64) -> f64 {
     let tau = m * tau0_s;
     1.5 * q * q / (tau * tau)
 }
 
 /// Haar WV of a random walk of density `k` (u/√s), step variance γ² = K²τ0.
-pub fn wv_random_walk(k: f64, m: f64, tau0_s: f64) -> f64 {
+pub(crate) fn wv_random_walk(k: f64, m: f64, tau0_s: f64) -> f64 {
     k * k * tau0_s * (2.0 * m * m + 1.0) / (12.0 * m)
 }
 
 /// Haar WV of a linear drift of slope `r` (u/s).
-pub fn wv_drift(r: f64, m: f64, tau0_s: f64) -> f64 {
+pub(crate) fn wv_drift(r: f64, m: f64, tau0_s: f64) -> f64 {
     let tau = m * tau0_s;
     r * r * tau * tau / 4.0
 }
 
 /// Haar WV of a stationary first-order Gauss–Markov (AR(1)) process sampled at τ0:
 /// stationary σ_b (u), correlation time T (s), φ = e^{−τ0/T}.
-pub fn wv_gauss_markov(sigma: f64, tau_c_s: f64, m: f64, tau0_s: f64) -> f64 {
+pub(crate) fn wv_gauss_markov(sigma: f64, tau_c_s: f64, m: f64, tau0_s: f64) -> f64 {
     let a = tau0_s / tau_c_s;
     let one_minus_phi = -(-a).exp_m1();
     let f = (-a).exp() * (c_u(m * a) + 2.0 * m * sinh_minus_x(a));

@@ -69,7 +69,7 @@ pub const DEFAULT_LEVEL: f64 = 0.01;
 
 /// Default τ span of the cross-run check, s: where white noise and the flicker floor of
 /// a MEMS IMU show and a model of one run should predict another run's curve.
-pub const CROSS_CHECK_TAU_S: (f64, f64) = (0.2, 30.0);
+pub(crate) const CROSS_CHECK_TAU_S: (f64, f64) = (0.2, 30.0);
 
 /// Largest relative difference of the runs' sample intervals taken as one sample rate
 /// (timestamps of real logs give slightly different estimates of one nominal rate).
@@ -320,7 +320,10 @@ pub struct RunShape<'a> {
 /// Whether `other` can be a replicate of `first`: the same channel names (any order) with
 /// the same quantities and sample rates within [`SAMPLE_RATE_TOLERANCE`]. The error names
 /// both runs and what differs.
-pub fn check_same_sensor(first: &RunShape<'_>, other: &RunShape<'_>) -> Result<(), ReplicateError> {
+pub(crate) fn check_same_sensor(
+    first: &RunShape<'_>,
+    other: &RunShape<'_>,
+) -> Result<(), ReplicateError> {
     let mismatch = |what: String| ReplicateError::Mismatch {
         first: first.source.into(),
         other: other.source.into(),

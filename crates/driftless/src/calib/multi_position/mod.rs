@@ -319,7 +319,11 @@ impl MultiPositionCalibration {
 
 /// Central-difference propagation of `cov` (n × n) through `f`: J·cov·Jᵀ, with step
 /// h_i = 1e-3·σ_i (or 1e-8·max(|p_i|, 1) when σ_i = 0).
-pub fn propagate_covariance(p: &[f64], cov: &[f64], f: impl Fn(&[f64]) -> Vec<f64>) -> Vec<f64> {
+pub(crate) fn propagate_covariance(
+    p: &[f64],
+    cov: &[f64],
+    f: impl Fn(&[f64]) -> Vec<f64>,
+) -> Vec<f64> {
     let n = p.len();
     let m = f(p).len();
     let mut jac = vec![0.0; m * n];

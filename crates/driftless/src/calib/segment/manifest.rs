@@ -12,7 +12,7 @@ impl Segmentation {
     }
 
     /// The findings about plateau `p` (missing positions or rotations, unsettled).
-    pub fn findings_of(&self, p: usize) -> Vec<&Finding> {
+    pub(crate) fn findings_of(&self, p: usize) -> Vec<&Finding> {
         self.findings
             .iter()
             .filter(|f| match f.kind {

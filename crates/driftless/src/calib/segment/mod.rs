@@ -211,7 +211,7 @@ pub struct StaticSegment {
 impl StaticSegment {
     /// The samples used as a static position, if any: the interval itself, or the tail
     /// of a soak.
-    pub fn position_span(&self) -> Option<Span> {
+    pub(crate) fn position_span(&self) -> Option<Span> {
         match self.role {
             StaticRole::Position => Some(self.span),
             StaticRole::Soak => self.position_tail,
@@ -269,7 +269,7 @@ impl TemperaturePlateau {
     }
 
     /// Holds any static position.
-    pub fn has_positions(&self) -> bool {
+    pub(crate) fn has_positions(&self) -> bool {
         self.positions.iter().any(|&n| n > 0)
     }
 }

@@ -64,7 +64,7 @@ impl CaseRun {
     }
 
     /// Mean end-of-outage horizontal error of the smoothed solution, m.
-    pub fn smoothed_mean_end_m(&self) -> Option<f64> {
+    pub(crate) fn smoothed_mean_end_m(&self) -> Option<f64> {
         self.smoothed.as_ref().and_then(mean_end)
     }
 }
@@ -93,7 +93,7 @@ pub struct VehicleRun {
 
 impl VehicleRun {
     /// A copy without the reference, fixes and solutions (for the Monte Carlo list).
-    pub fn without_solutions(&self) -> VehicleRun {
+    pub(crate) fn without_solutions(&self) -> VehicleRun {
         VehicleRun {
             run: self.run,
             cases: self

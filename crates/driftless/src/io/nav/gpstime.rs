@@ -13,7 +13,7 @@
 //! by that date.
 
 /// Seconds in one GPS week.
-pub const SECONDS_PER_WEEK: f64 = 604_800.0;
+pub(crate) const SECONDS_PER_WEEK: f64 = 604_800.0;
 /// Seconds in one day.
 const SECONDS_PER_DAY: i64 = 86_400;
 /// Days from 1970-01-01 to the GPS epoch 1980-01-06.
@@ -21,7 +21,7 @@ const GPS_EPOCH_DAYS_FROM_1970: i64 = 3_657;
 
 /// Days from 1970-01-01 to the GPS epoch, as Unix seconds: 1980-01-06 00:00:00 is
 /// 3 657 × 86 400 = 315 964 800 s after 1970-01-01 00:00:00 in either scale (GPS − UTC was 0).
-pub const GPS_EPOCH_UNIX_S: f64 = 315_964_800.0;
+pub(crate) const GPS_EPOCH_UNIX_S: f64 = 315_964_800.0;
 
 /// GPS − UTC leap seconds: (first UTC day it applies, as (year, month, day); GPS − UTC, s).
 ///
@@ -172,7 +172,11 @@ impl TimeBase {
     /// Seconds since the GPS epoch of a time stamp `t_s` in this base. For the week-based
     /// bases `week` is the week `t_s` counts from (`t_s` may pass 604 800 s or be the
     /// seconds of that week); without it they have no absolute time (`None`).
-    pub fn gps_seconds(self, t_s: f64, week: Option<u16>) -> Result<Option<f64>, TimeBaseError> {
+    pub(crate) fn gps_seconds(
+        self,
+        t_s: f64,
+        week: Option<u16>,
+    ) -> Result<Option<f64>, TimeBaseError> {
         let base = self.name();
         if !t_s.is_finite() {
             return Err(TimeBaseError::NonFinite { value_s: t_s, base });
@@ -313,7 +317,7 @@ fn days_in_month(year: i32, month: u32) -> u32 {
 impl Calendar {
     /// True when every field is in range (month 1–12, a day that exists, hour < 24,
     /// minute < 60, 0 ≤ second < 60).
-    pub fn is_valid(&self) -> bool {
+    pub(crate) fn is_valid(&self) -> bool {
         (1..=12).contains(&self.month)
             && self.day >= 1
             && self.day <= days_in_month(self.year, self.month)
@@ -327,7 +331,7 @@ impl Calendar {
 impl GpsTime {
     /// GPS time of a GPST calendar date and time; `None` when the calendar fields are out
     /// of range or the time is before the GPS epoch or after week 65 535.
-    pub fn from_calendar(c: &Calendar) -> Option<GpsTime> {
+    pub(crate) fn from_calendar(c: &Calendar) -> Option<GpsTime> {
         if !c.is_valid() {
             return None;
         }
@@ -375,7 +379,7 @@ impl GpsTime {
     }
 
     /// Seconds from the start of week `week` (may exceed a week or be negative).
-    pub fn seconds_since_week(&self, week: u16) -> f64 {
+    pub(crate) fn seconds_since_week(&self, week: u16) -> f64 {
         (f64::from(self.week) - f64::from(week)) * SECONDS_PER_WEEK + self.sow_s
     }
 }

@@ -58,11 +58,11 @@ const MGAL_PER_M_S2: f64 = 1e5;
 const PPM: f64 = 1e6;
 
 /// File names KF-GINS writes into `outputpath`.
-pub const NAV_FILE: &str = "KF_GINS_Navresult.nav";
+pub(crate) const NAV_FILE: &str = "KF_GINS_Navresult.nav";
 /// IMU-error file name.
-pub const IMU_ERR_FILE: &str = "KF_GINS_IMU_ERR.txt";
+pub(crate) const IMU_ERR_FILE: &str = "KF_GINS_IMU_ERR.txt";
 /// State-std file name.
-pub const STD_FILE: &str = "KF_GINS_STD.txt";
+pub(crate) const STD_FILE: &str = "KF_GINS_STD.txt";
 
 /// What a GNSS reader does with a standard deviation of zero.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -1289,7 +1289,7 @@ pub const SMOOTHED_SUFFIX: &str = "_smoothed";
 
 /// KF-GINS's three output file names with `suffix` before the extension (`""`: KF-GINS's
 /// own names).
-pub fn output_file_names(suffix: &str) -> [String; 3] {
+pub(crate) fn output_file_names(suffix: &str) -> [String; 3] {
     [NAV_FILE, IMU_ERR_FILE, STD_FILE].map(|f| match f.rsplit_once('.') {
         Some((stem, ext)) => format!("{stem}{suffix}.{ext}"),
         None => format!("{f}{suffix}"),
@@ -1354,7 +1354,7 @@ impl KfGinsOutputWriter {
 
     /// [`KfGinsOutputWriter::create`] with `suffix` before each file's extension
     /// ([`output_file_names`], e.g. [`SMOOTHED_SUFFIX`]).
-    pub fn create_with_suffix(
+    pub(crate) fn create_with_suffix(
         dir: impl AsRef<Path>,
         gps_week: u16,
         suffix: &str,

@@ -299,7 +299,7 @@ impl KfGinsConfig {
 
     /// Converts a raw (KF-GINS-unit) configuration to SI with KF-GINS's factors. The raw
     /// values are assumed checked (as [`KfGinsConfigRaw::from_yaml_str`] does).
-    pub fn from_raw(raw: KfGinsConfigRaw) -> KfGinsConfig {
+    pub(crate) fn from_raw(raw: KfGinsConfigRaw) -> KfGinsConfig {
         let d2r3 = |v: [f64; 3]| v.map(|x| x * D2R);
         let dph = |v: [f64; 3]| v.map(|x| x * D2R / 3600.0);
         let mgal = |v: [f64; 3]| v.map(|x| x * 1e-5);

@@ -84,6 +84,17 @@ pub(super) fn declared_rows(region: &[u8]) -> Option<(usize, bool)> {
     Some((n, marked))
 }
 
+/// The header of a EuRoC / TUM-VI IMU CSV (`#timestamp [ns],w_RS_S_x [rad s^-1],…,
+/// a_RS_S_z [m s^-2]`) without its `#`: a comment line by the rules above, taken as the
+/// header when it is the first line with content (its bracketed units then give ns time
+/// stamps, rad/s and m/s²).
+pub(super) fn euroc_header(line: &[u8]) -> Option<&[u8]> {
+    let rest = line.trim_ascii_start().strip_prefix(b"#")?;
+    let is_euroc = rest.trim_ascii_start().starts_with(b"timestamp")
+        && rest.windows(8).any(|w| w == b"w_RS_S_x");
+    is_euroc.then_some(rest)
+}
+
 /// True when the line holds no data (blank or comment).
 #[inline]
 pub(super) fn is_blank_or_comment(line: &[u8]) -> bool {

@@ -11,7 +11,8 @@ use crate::io::input::{SNIFF_BYTES, binary_error};
 use crate::io::log::{Channel, ImuLog};
 
 use super::fields::{
-    declared_rows, field_count, is_blank_or_comment, line_len_with_end, lines, split_pieces,
+    declared_rows, euroc_header, field_count, is_blank_or_comment, line_len_with_end, lines,
+    split_pieces,
 };
 use super::options::{TextOptions, validate};
 use super::parse::{FieldErr, LineMap, PieceErr, PieceOut, parse_line, parse_piece, piece_error};
@@ -196,12 +197,13 @@ fn sample_lines<'a>(
                 ),
             );
         }
-        if !is_blank_or_comment(line) {
+        let euroc = sample.is_empty().then(|| euroc_header(line)).flatten();
+        if let Some(text) = euroc.or((!is_blank_or_comment(line)).then_some(line)) {
             starts.push(offset);
             sample.push(SampleLine {
                 line: line_base + i,
                 end: offset + this_len,
-                text: line,
+                text,
             });
             if sample.len() > REFERENCE_SAMPLE + 2 {
                 break;

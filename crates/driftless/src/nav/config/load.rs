@@ -80,7 +80,7 @@ pub(super) fn merge(into: &mut toml::Table, from: toml::Table) {
 
 impl LoadedConfig {
     /// Where key `path` was set, for messages.
-    pub fn locate(&self, path: &str) -> String {
+    pub(crate) fn locate(&self, path: &str) -> String {
         if self.from_flags.contains(path) {
             let flag = key_by_path(path).map_or(path, |k| k.flag);
             return format!("flag --{flag}");

@@ -106,7 +106,7 @@ impl Kind {
     }
 
     /// The accepted units, as written in messages.
-    pub fn unit_list(self) -> String {
+    pub(crate) fn unit_list(self) -> String {
         self.units()
             .iter()
             .map(|(u, _)| if u.is_empty() { "(none)" } else { u })

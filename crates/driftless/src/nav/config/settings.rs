@@ -34,7 +34,7 @@ impl NavConfig {
     }
 
     /// The IMU value checks ([`crate::nav::imu_check`]) with the configured hard limits.
-    pub fn imu_check_config(&self) -> crate::nav::imu_check::ImuCheckConfig {
+    pub(crate) fn imu_check_config(&self) -> crate::nav::imu_check::ImuCheckConfig {
         crate::nav::imu_check::ImuCheckConfig {
             max_gyro_rad_s: self.imu.max_gyro_deg_s.to_radians(),
             max_accel_m_s2: self.imu.max_accel_g * driftless_model::units::STANDARD_GRAVITY,
@@ -43,7 +43,7 @@ impl NavConfig {
     }
 
     /// The quality flags accepted (index = RTKLIB flag).
-    pub fn accepted_qualities(&self) -> [bool; 7] {
+    pub(crate) fn accepted_qualities(&self) -> [bool; 7] {
         let mut ok = [false; 7];
         for (k, name) in QUALITY_NAMES.iter().enumerate() {
             ok[k] = self.gnss.accept.iter().any(|a| a == name);
@@ -52,7 +52,7 @@ impl NavConfig {
     }
 
     /// σ multipliers per quality flag.
-    pub fn quality_scale(&self) -> QualityScale {
+    pub(crate) fn quality_scale(&self) -> QualityScale {
         QualityScale(self.gnss.sigma_scale.as_array())
     }
 

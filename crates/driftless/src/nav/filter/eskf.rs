@@ -109,7 +109,7 @@ impl Eskf {
     }
 
     /// Replace the gate applied to GNSS updates.
-    pub fn set_gate(&mut self, gate: Gate) {
+    pub(crate) fn set_gate(&mut self, gate: Gate) {
         self.gate = gate;
     }
 
@@ -231,12 +231,12 @@ impl Eskf {
     }
 
     /// Last compensated angular rate ω̂_ib^b, rad/s.
-    pub fn omega_ib_b_rad_s(&self) -> Vec3 {
+    pub(crate) fn omega_ib_b_rad_s(&self) -> Vec3 {
         self.last_omega_b_rad_s
     }
 
     /// The compensated increment used by the last predict.
-    pub fn last_compensated(&self) -> Option<ImuIncrement> {
+    pub(crate) fn last_compensated(&self) -> Option<ImuIncrement> {
         self.prev_inc
     }
 

@@ -19,29 +19,29 @@ pub const N_STATES: usize = 21;
 /// First index of the position error.
 pub const POS: usize = 0;
 /// First index of the velocity error.
-pub const VEL: usize = 3;
+pub(crate) const VEL: usize = 3;
 /// First index of the attitude error.
-pub const ATT: usize = 6;
+pub(crate) const ATT: usize = 6;
 /// First index of the gyro bias.
-pub const BG: usize = 9;
+pub(crate) const BG: usize = 9;
 /// First index of the accelerometer bias.
-pub const BA: usize = 12;
+pub(crate) const BA: usize = 12;
 /// First index of the gyro scale factor.
-pub const SG: usize = 15;
+pub(crate) const SG: usize = 15;
 /// First index of the accelerometer scale factor.
-pub const SA: usize = 18;
+pub(crate) const SA: usize = 18;
 
 /// A full 21 × 21 covariance (row-major, symmetric).
 pub type Cov = [[f64; N_STATES]; N_STATES];
 
 /// Number of elements of the packed upper triangle of a [`Cov`].
-pub const N_PACKED: usize = N_STATES * (N_STATES + 1) / 2;
+pub(crate) const N_PACKED: usize = N_STATES * (N_STATES + 1) / 2;
 
 /// Packed upper triangle (row by row: (0,0), (0,1), …, (0,20), (1,1), …) of a covariance.
 pub type PackedCov = [f64; N_PACKED];
 
 /// Pack the upper triangle of `p`.
-pub fn pack(p: &Cov) -> Box<PackedCov> {
+pub(crate) fn pack(p: &Cov) -> Box<PackedCov> {
     let mut out = Box::new([0.0; N_PACKED]);
     let mut k = 0;
     for (i, row) in p.iter().enumerate() {
@@ -105,7 +105,7 @@ pub fn check_covariance(p: &Cov, rel_tol: f64) -> Result<(), String> {
 /// [`check_covariance`] with the symmetry tolerance relative to √(s_i s_j) for a given
 /// variance scale `s` (e.g. the prior diagonal of an update, whose rounding the
 /// posterior inherits when an update shrinks a variance by orders of magnitude).
-pub fn check_covariance_scaled(
+pub(crate) fn check_covariance_scaled(
     p: &Cov,
     rel_tol: f64,
     scale_diag: &[f64; N_STATES],
@@ -161,7 +161,7 @@ pub fn check_covariance_scaled(
 }
 
 /// Human-readable name of error state `i`.
-pub fn state_name(i: usize) -> &'static str {
+pub(crate) fn state_name(i: usize) -> &'static str {
     const NAMES: [&str; N_STATES] = [
         "δr_N", "δr_E", "δr_D", "δv_N", "δv_E", "δv_D", "φ_N", "φ_E", "φ_D", "b_gx", "b_gy",
         "b_gz", "b_ax", "b_ay", "b_az", "s_gx", "s_gy", "s_gz", "s_ax", "s_ay", "s_az",

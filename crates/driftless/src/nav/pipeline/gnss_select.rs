@@ -59,7 +59,7 @@ pub struct GnssSelection {
 }
 
 /// The rows of `g` where `keep` is true (every column).
-pub fn subset_fixes(g: &GnssFixes, keep: &[bool]) -> GnssFixes {
+pub(crate) fn subset_fixes(g: &GnssFixes, keep: &[bool]) -> GnssFixes {
     fn pick<T: Copy>(v: &[T], keep: &[bool]) -> Vec<T> {
         v.iter()
             .zip(keep)

@@ -273,7 +273,7 @@ impl Mounting {
     }
 
     /// True when both rotations are zero.
-    pub fn is_identity(&self) -> bool {
+    pub(crate) fn is_identity(&self) -> bool {
         self.rpy_deg == [0.0; 3] && self.misalignment_rpy_deg == [0.0; 3]
     }
 }
@@ -374,7 +374,7 @@ impl ImuStream {
     /// (rad/s per m/s², raw = … + G·f, as six-position calibration estimates it; none when
     /// `gyro_g_sensitivity` is `None`) integrated over each interval (exact for constant
     /// M, b, G).
-    pub fn apply_calibration(
+    pub(crate) fn apply_calibration(
         &mut self,
         cal: &driftless_model::calib::ImuCalibration,
         gyro_g_sensitivity: Option<&driftless_model::linalg::Mat3>,

@@ -12,7 +12,7 @@ pub struct TaggedCsvOptions {
 }
 
 /// Column names of the tagged IMU CSV, in file order.
-pub const TAGGED_CSV_COLUMNS: [&str; 7] =
+pub(crate) const TAGGED_CSV_COLUMNS: [&str; 7] =
     ["acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z", "tick"];
 
 /// Stream from a tick-stamped IMU CSV in memory (`acc_x, acc_y, acc_z [g], gyr_x, gyr_y,

@@ -16,7 +16,7 @@ pub fn solution_records(
 
 /// [`solution_records`] of a block of epoch records (e.g. one handed out by
 /// [`super::super::filter::run_forward_observed`]).
-pub fn epoch_solution_records(
+pub(crate) fn epoch_solution_records(
     epochs: &[super::super::filter::EpochRecord],
 ) -> (
     crate::io::nav::NavSolution,
@@ -30,7 +30,7 @@ pub fn epoch_solution_records(
 /// √diag(P) in the order of [`super::super::filter::state`] — e.g. forward records or smoothed
 /// epochs ([`super::super::filter::SmoothedEpoch`]). Attitude as roll, pitch, yaw from
 /// [`Euler::from_dcm`] (yaw in (−π, π]).
-pub fn state_solution_records<'a>(
+pub(crate) fn state_solution_records<'a>(
     states: impl IntoIterator<
         Item = (
             &'a NavState,

@@ -216,7 +216,7 @@ impl Line {
         self
     }
 
-    pub fn with_style(mut self, style: LineStyle) -> Self {
+    pub(crate) fn with_style(mut self, style: LineStyle) -> Self {
         self.style = style;
         self
     }

@@ -27,13 +27,13 @@ impl Rect {
     pub fn contains(&self, p: Pt) -> bool {
         p.0 >= self.x && p.0 <= self.right() && p.1 >= self.y && p.1 <= self.bottom()
     }
-    pub fn contains_rect(&self, r: &Rect) -> bool {
+    pub(crate) fn contains_rect(&self, r: &Rect) -> bool {
         r.x >= self.x && r.y >= self.y && r.right() <= self.right() && r.bottom() <= self.bottom()
     }
     pub fn inflate(&self, d: f64) -> Rect {
         Rect::new(self.x - d, self.y - d, self.w + 2.0 * d, self.h + 2.0 * d)
     }
-    pub fn overlap_area(&self, o: &Rect) -> f64 {
+    pub(crate) fn overlap_area(&self, o: &Rect) -> f64 {
         let w = self.right().min(o.right()) - self.x.max(o.x);
         let h = self.bottom().min(o.bottom()) - self.y.max(o.y);
         if w > 0.0 && h > 0.0 { w * h } else { 0.0 }

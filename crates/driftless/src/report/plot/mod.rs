@@ -67,7 +67,7 @@ pub use svg::xml_escape;
 pub use text::text_width;
 
 /// Whether this build can write PNG (the `png` cargo feature).
-pub const PNG_SUPPORTED: bool = cfg!(feature = "png");
+pub(crate) const PNG_SUPPORTED: bool = cfg!(feature = "png");
 
 /// Default PNG resolution: 2 device pixels per SVG px (crisp text on
 /// high-DPI screens and in print).

@@ -26,7 +26,7 @@ const LOG_LIMIT: f64 = 330.0;
 
 /// `log10` of the finite, strictly positive values, as `(min, max)`.
 /// `None` when there are none (all NaN / zero / negative / empty).
-pub fn log_extent(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
+pub(crate) fn log_extent(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
     let mut ext: Option<(f64, f64)> = None;
     for v in values {
         if v.is_finite() && v > 0.0 {
@@ -43,7 +43,7 @@ pub fn log_extent(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
 /// Displayed log-range for data spanning `[lmin, lmax]` (log10 units): a
 /// margin of 4 % each side (so markers on a decade are not cut by the frame),
 /// widened symmetrically to at least one decade.
-pub fn padded_range(lmin: f64, lmax: f64) -> (f64, f64) {
+pub(crate) fn padded_range(lmin: f64, lmax: f64) -> (f64, f64) {
     let (mut lo, mut hi) = if lmin <= lmax {
         (lmin, lmax)
     } else {
@@ -63,7 +63,7 @@ pub fn padded_range(lmin: f64, lmax: f64) -> (f64, f64) {
 
 /// Log-range for a user-given `(min, max)` in data units; `None` if it is not
 /// a valid positive range.
-pub fn explicit_range(range: (f64, f64)) -> Option<(f64, f64)> {
+pub(crate) fn explicit_range(range: (f64, f64)) -> Option<(f64, f64)> {
     let (a, b) = range;
     if !(a.is_finite() && b.is_finite() && a > 0.0 && b > 0.0 && a != b) {
         return None;
@@ -428,7 +428,7 @@ pub(crate) struct AxisMap {
 
 impl AxisMap {
     /// Whether the axis can show `v` (finite, and positive on a log axis).
-    pub fn accepts(&self, v: f64) -> bool {
+    pub(crate) fn accepts(&self, v: f64) -> bool {
         match self.scale {
             AxisScale::Log => v.is_finite() && v > 0.0,
             AxisScale::Linear => v.is_finite(),
@@ -447,7 +447,7 @@ impl AxisMap {
     }
 
     /// Pixel of an axis coordinate (e.g. [`Tick::log`]).
-    pub fn px_log(&self, l: f64) -> f64 {
+    pub(crate) fn px_log(&self, l: f64) -> f64 {
         self.p0 + (l - self.lo) / (self.hi - self.lo) * (self.p1 - self.p0)
     }
 }

@@ -46,7 +46,7 @@ fn num(v: f64) -> String {
     if s == "-0" { "0".to_owned() } else { s }
 }
 
-pub(crate) fn write_svg(scene: &Scene) -> String {
+pub fn write_svg(scene: &Scene) -> String {
     let mut o = String::with_capacity(64 * scene.items.len() + 512);
     let (w, h) = (num(scene.width), num(scene.height));
     let _ = writeln!(

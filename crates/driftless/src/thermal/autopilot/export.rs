@@ -120,7 +120,7 @@ pub(super) fn check_instance(
 }
 
 /// PX4 parameters of the bias part (module docs).
-pub fn px4_params(m: &BiasModel, o: &ExportOptions) -> Result<Vec<Param>, AutopilotError> {
+pub(crate) fn px4_params(m: &BiasModel, o: &ExportOptions) -> Result<Vec<Param>, AutopilotError> {
     let n = check_instance(o.instance, PX4_INSTANCES, "PX4")?;
     let mut p = Vec::new();
     for (letter, cal, t, id) in [
@@ -173,7 +173,10 @@ pub(super) fn ardupilot_offs_name(accel: bool, n: usize, axis: char) -> String {
 }
 
 /// ArduPilot parameters of the bias part (module docs).
-pub fn ardupilot_params(m: &BiasModel, o: &ExportOptions) -> Result<Vec<Param>, AutopilotError> {
+pub(crate) fn ardupilot_params(
+    m: &BiasModel,
+    o: &ExportOptions,
+) -> Result<Vec<Param>, AutopilotError> {
     let n = check_instance(o.instance, ARDUPILOT_INSTANCES, "ArduPilot")?;
     let g = format!("INS_TCAL{}_", n + 1);
     let mut p = vec![

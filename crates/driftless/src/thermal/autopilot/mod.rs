@@ -89,17 +89,17 @@ pub use parse::*;
 pub use roundtrip::*;
 
 /// ArduPilot's fixed reference temperature of the `INS_TCAL*` polynomial (`TEMP_REFERENCE`).
-pub const ARDUPILOT_TEMP_REFERENCE_C: f64 = 35.0;
+pub(crate) const ARDUPILOT_TEMP_REFERENCE_C: f64 = 35.0;
 /// ArduPilot stores coefficients multiplied by this (`SCALE_FACTOR`).
-pub const ARDUPILOT_COEFF_SCALE: f64 = 1.0e6;
+pub(crate) const ARDUPILOT_COEFF_SCALE: f64 = 1.0e6;
 /// ArduPilot's default of `INS_ACCn_CALTEMP` / `INS_GYRn_CALTEMP` (unset).
-pub const ARDUPILOT_CALTEMP_DEFAULT_C: f32 = -300.0;
+pub(crate) const ARDUPILOT_CALTEMP_DEFAULT_C: f32 = -300.0;
 /// PX4 accelerometer/gyro thermal-compensation instances (`TC_A0` … `TC_A3`).
-pub const PX4_INSTANCES: usize = 4;
+pub(crate) const PX4_INSTANCES: usize = 4;
 /// ArduPilot `INS_TCAL1_` … `INS_TCAL3_` groups.
-pub const ARDUPILOT_INSTANCES: usize = 3;
+pub(crate) const ARDUPILOT_INSTANCES: usize = 3;
 /// Highest exportable polynomial order.
-pub const MAX_EXPORT_ORDER: usize = 3;
+pub(crate) const MAX_EXPORT_ORDER: usize = 3;
 
 const AXES: [char; 3] = ['X', 'Y', 'Z'];
 

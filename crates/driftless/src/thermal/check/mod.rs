@@ -112,13 +112,7 @@ impl Default for CheckOptions {
 }
 
 /// A time span of the log, s (the log's own time axis).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct TimeSpan {
-    /// Start, s.
-    pub start_s: f64,
-    /// End, s.
-    pub end_s: f64,
-}
+pub use crate::data::TimeSpan;
 
 /// How a finding affects a method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -308,7 +302,7 @@ impl ThermalCheck {
     }
 
     /// The findings that block `ramp` (true) or soak (false), their messages joined.
-    pub fn blocking(&self, ramp: bool) -> Vec<&Finding> {
+    pub(crate) fn blocking(&self, ramp: bool) -> Vec<&Finding> {
         self.findings
             .iter()
             .filter(|f| (if ramp { f.ramp } else { f.soak }) == Impact::Block)

@@ -276,7 +276,7 @@ impl ThermalFit {
     /// Standard error of the fitted curve at `t_c`: σ_fit(T)² = gᵀ C g,
     /// g = (1, ΔT, …, ΔT^p) — computed in the equivalent scaled basis
     /// g_u = (1, u, …, u^p), σ² = g_uᵀ Cov(a) g_u, for conditioning.
-    pub fn std_error_at(&self, t_c: f64) -> f64 {
+    pub(crate) fn std_error_at(&self, t_c: f64) -> f64 {
         let m = self.order + 1;
         let u = (t_c - self.t_centre) / self.half_range;
         let mut g = vec![1.0; m];

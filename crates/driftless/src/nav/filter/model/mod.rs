@@ -89,7 +89,7 @@ pub struct GaussMarkov {
 
 impl GaussMarkov {
     /// Continuous driving-noise PSD q = 2σ²/T.
-    pub fn psd(&self) -> f64 {
+    pub(crate) fn psd(&self) -> f64 {
         2.0 * self.sigma * self.sigma / self.tau_s
     }
 }
@@ -403,7 +403,7 @@ impl FilterConfig {
 
     /// The stationary Gauss–Markov σ of the 12 sensor states (b_g, b_a, s_g, s_a, three
     /// each): the default initial uncertainty.
-    pub fn stationary_sensor_sigma(&self) -> [f64; 12] {
+    pub(crate) fn stationary_sensor_sigma(&self) -> [f64; 12] {
         let n = &self.imu;
         let mut s = [0.0; 12];
         for k in 0..3 {
