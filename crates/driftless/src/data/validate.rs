@@ -135,13 +135,6 @@ fn check_increasing(what: &'static str, time_s: &[f64]) -> Result<(), DataError>
     }
 }
 
-/// Median of the successive differences of a strictly increasing column (len ≥ 2).
-fn median_interval_s(time_s: &[f64]) -> f64 {
-    let mut d: Vec<f64> = time_s.windows(2).map(|w| w[1] - w[0]).collect();
-    let mid = d.len() / 2;
-    *d.select_nth_unstable_by(mid, f64::total_cmp).1
-}
-
 impl ImuLog {
     /// A log of rates from arrays: time stamps `time_s` (s, strictly increasing), gyro
     /// `gyro_rad_s` and specific force `accel_m_s2` (body x, y, z per row). Channels are
@@ -183,7 +176,9 @@ impl ImuLog {
             column("acc_y", Quantity::SpecificForce, accel_m_s2, 1),
             column("acc_z", Quantity::SpecificForce, accel_m_s2, 2),
         ];
-        let tau0_s = median_interval_s(&time_s);
+        // τ0: the (upper) median time-stamp interval; n ≥ 2 rows give at least one.
+        let mut intervals: Vec<f64> = time_s.windows(2).map(|w| w[1] - w[0]).collect();
+        let tau0_s = crate::numeric::order::upper_median(&mut intervals).unwrap_or(f64::NAN);
         Ok(ImuLog::new(source, Some(time_s), tau0_s, channels))
     }
 
