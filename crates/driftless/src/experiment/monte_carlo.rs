@@ -19,9 +19,10 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::ExperimentError;
+use crate::numeric::splitmix::splitmix64_mix;
 use super::budget::{ReversalCount, reversal_counts};
 use super::run::{
-    Case, NoiseStage, Prepared, ThermalStage, VehicleRun, noise_stage, splitmix64, thermal_stage,
+    Case, NoiseStage, Prepared, ThermalStage, VehicleRun, noise_stage, thermal_stage,
     vehicle_run,
 };
 
@@ -214,7 +215,7 @@ pub(crate) fn ratio_interval(
         .map(|_| {
             let (mut s1, mut s2) = (0.0, 0.0);
             for _ in 0..n {
-                state = splitmix64(state);
+                state = splitmix64_mix(state);
                 let (a, b) = pairs[(state % n as u64) as usize];
                 s1 += a;
                 s2 += b;
@@ -351,7 +352,7 @@ pub fn run_experiment(
     let summary = summarise(
         &all,
         p.scenario.monte_carlo.confidence,
-        splitmix64(p.scenario.seed ^ 0xB007),
+        splitmix64_mix(p.scenario.seed ^ 0xB007),
     );
     Ok(ExperimentResult {
         noise,
@@ -382,7 +383,7 @@ mod tests {
         // runs scatter ±20 %.
         let mut s = 7u64;
         let mut u = || {
-            s = splitmix64(s);
+            s = splitmix64_mix(s);
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
         let mk = |pairs: usize, u: &mut dyn FnMut() -> f64| {

@@ -25,6 +25,7 @@ use crate::eval::reference::reference_from_fixes;
 use crate::eval::select::{SelectOptions, SelectedOutage, resolve_outages};
 use crate::io::nav::{GnssReadOptions, NavSolution};
 use crate::io::{ImuLog, Quantity};
+use crate::numeric::splitmix::splitmix64_mix;
 use crate::nav::filter::model::FilterConfig;
 use crate::nav::outage::{OutageSpec, OutageWindow};
 use crate::nav::pipeline::{
@@ -126,17 +127,9 @@ impl Prepared {
     }
 }
 
-/// 64-bit mix (Steele et al., SplitMix64) for per-run seeds.
-pub fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 /// Seed of stage `tag` in Monte Carlo run `run`.
 pub fn run_seed(seed: u64, tag: u64, run: usize) -> u64 {
-    splitmix64(seed ^ tag.wrapping_mul(0x1000_0000_01B3) ^ (run as u64).wrapping_mul(0x9E37))
+    splitmix64_mix(seed ^ tag.wrapping_mul(0x1000_0000_01B3) ^ (run as u64).wrapping_mul(0x9E37))
 }
 
 const TAG_NOISE: u64 = 1;
