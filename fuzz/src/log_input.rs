@@ -73,7 +73,10 @@ pub fn run(data: &[u8]) {
             // The bag reader reads twice (topics, then messages), so it refuses a pipe
             // whatever the bytes hold; a regular file reaches the reader's own errors.
             assert!(
-                from_pipe.read.as_ref().is_err_and(|e| e.contains("read twice")),
+                from_pipe
+                    .read
+                    .as_ref()
+                    .is_err_and(|e| e.contains("read twice")),
                 "FIFO read {:?}, regular file {:?}",
                 from_pipe.read,
                 from_file.read

@@ -19,12 +19,11 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::ExperimentError;
-use crate::numeric::splitmix::splitmix64_mix;
 use super::budget::{ReversalCount, reversal_counts};
 use super::run::{
-    Case, NoiseStage, Prepared, ThermalStage, VehicleRun, noise_stage, thermal_stage,
-    vehicle_run,
+    Case, NoiseStage, Prepared, ThermalStage, VehicleRun, noise_stage, thermal_stage, vehicle_run,
 };
+use crate::numeric::splitmix::splitmix64_mix;
 
 impl ExperimentResult {
     /// Per case (run 0's order): label and each run's mean end-of-outage horizontal

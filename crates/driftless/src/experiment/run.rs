@@ -25,13 +25,13 @@ use crate::eval::reference::reference_from_fixes;
 use crate::eval::select::{SelectOptions, SelectedOutage, resolve_outages};
 use crate::io::nav::{GnssReadOptions, NavSolution};
 use crate::io::{ImuLog, Quantity};
-use crate::numeric::splitmix::splitmix64_mix;
 use crate::nav::filter::model::FilterConfig;
 use crate::nav::outage::{OutageSpec, OutageWindow};
 use crate::nav::pipeline::{
     GnssOutsideImu, ImuStreamOptions, imu_from_kfgins, read_gnss_file, select_gnss,
 };
 use crate::nav::session::SessionConfig;
+use crate::numeric::splitmix::splitmix64_mix;
 use crate::sim::scenario::{ErrorTerms, ImuSpec, OutputSpec, Scenario, TrajectorySpec};
 use crate::sim::sensor_config::SensorConfig;
 use crate::sim::sensor_data::OutputKind;
