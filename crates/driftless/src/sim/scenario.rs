@@ -423,52 +423,122 @@ impl Scenario {
         }
         let dt = 1.0 / rate;
         let sensor = self.sensor_config()?;
-        let model = SensorModel::new(sensor.clone()).map_err(|source| ScenarioError::Sensor {
-            path: self.name.clone(),
-            source,
-        })?;
-        let sim_err = |source| ScenarioError::Sim {
-            path: self.name.clone(),
-            source,
+        let model = SensorModel::new(sensor.clone()).map_err(|source| self.sensor_error(source))?;
+        let Motion {
+            traj,
+            t0,
+            t1,
+            offset,
+            manifest,
+            temperature,
+        } = self.motion(rate)?;
+        if !offset.is_finite() {
+            return Err(self.invalid("start_time_s must be finite"));
+        }
+        let n = ((t1 - t0) * rate + 1e-9).floor() as usize;
+        if n < 2 {
+            return Err(self.invalid(format!(
+                "the trajectory lasts {} s: fewer than two IMU samples at {rate} Hz",
+                t1 - t0
+            )));
+        }
+        let first = match self.imu.output {
+            OutputKind::Increments => t0 + dt,
+            OutputKind::Rates => t0,
         };
-        let sens_err = |source| ScenarioError::Sensor {
+        let n = match self.imu.output {
+            OutputKind::Increments => n,
+            OutputKind::Rates => n + 1,
+        };
+        let curve = temperature
+            .curve()
+            .map_err(|source| self.sensor_error(source))?;
+        let ideal = match &self.trajectory {
+            // A static IMU's ideal output is one constant: no per-sample evaluation.
+            TrajectorySpec::Static { .. } => {
+                let (w, f) = traj.point(t0).imu_rates();
+                IdealImu::constant(self.imu.output, first, dt, n, w, f)
+            }
+            _ => IdealImu::from_trajectory(&*traj, self.imu.output, first, dt, n),
+        };
+        let mut imu = model
+            .simulate(&ideal, &curve, self.seed)
+            .map_err(|source| self.sensor_error(source))?;
+        imu.first_time_s += offset;
+
+        let (mut gnss, mut gnss_outages_s, mut lever) = (None, Vec::new(), [0.0; 3]);
+        if let Some(g) = &self.gnss {
+            let (fixes, outages_s) = self.gnss_fixes(g, &*traj, t0, t1, offset)?;
+            (gnss, gnss_outages_s, lever) = (Some(fixes), outages_s, g.lever_arm_b_m);
+        }
+
+        // Truth.
+        let moving = matches!(
+            self.trajectory,
+            TrajectorySpec::Recorded { .. } | TrajectorySpec::Profile { .. }
+        );
+        let truth_rate =
+            self.output
+                .truth_rate_hz
+                .unwrap_or(if moving { rate } else { rate.min(1.0) });
+        if !(truth_rate.is_finite() && truth_rate > 0.0) {
+            return Err(self.invalid(format!(
+                "output.truth_rate_hz must be > 0, got {truth_rate}"
+            )));
+        }
+        let nt = ((t1 - t0) * truth_rate + 1e-9).floor() as usize + 1;
+        let truth = truth_solution(&*traj, t0, 1.0 / truth_rate, nt, offset);
+        let mut initial = traj.point(t0).nav_state(t0 + offset);
+        initial.q_bn = initial.q_bn.normalized();
+        Ok(Simulation {
+            imu,
+            gnss,
+            gnss_outages_s,
+            truth,
+            initial,
+            sensor,
+            manifest,
+            lever_arm_b_m: lever,
+        })
+    }
+
+    fn sensor_error(&self, source: super::sensor_error::SensorSimError) -> ScenarioError {
+        ScenarioError::Sensor {
             path: self.name.clone(),
             source,
-        };
-        // The motion: a trajectory on its own clock, its span, and the output offset.
-        let traj: Box<dyn Trajectory + Sync>;
-        let (t0, t1, offset);
-        let mut manifest = None;
-        let mut temperature = self
+        }
+    }
+
+    fn sim_error(&self, source: super::noise::SimError) -> ScenarioError {
+        ScenarioError::Sim {
+            path: self.name.clone(),
+            source,
+        }
+    }
+
+    /// The motion of the `[trajectory]` table at IMU rate `rate_hz`.
+    fn motion(&self, rate_hz: f64) -> Result<Motion, ScenarioError> {
+        let temperature = self
             .temperature
             .clone()
             .unwrap_or(TemperatureProfile::constant(25.0));
-        match &self.trajectory {
+        let plain = |traj: Box<dyn Trajectory + Sync>, t0, t1, offset| Motion {
+            traj,
+            t0,
+            t1,
+            offset,
+            manifest: None,
+            temperature: temperature.clone(),
+        };
+        Ok(match &self.trajectory {
             TrajectorySpec::Recorded {
                 file,
                 position_cutoff_hz,
                 roll,
             } => {
-                let path = self.resolve(file);
-                let fixes =
-                    crate::nav::pipeline::read_gnss_file(&path, &GnssReadOptions::default())
-                        .map_err(|e| self.invalid(format!("trajectory.file: {e}")))?;
-                let mut opts = RecordedOptions::default();
-                if let Some(f) = position_cutoff_hz {
-                    opts.position_cutoff_hz = *f;
-                }
-                opts.roll = match roll.as_deref() {
-                    None | Some("zero") => RollModel::Zero,
-                    Some("coordinated_turn") => RollModel::CoordinatedTurn,
-                    Some(other) => {
-                        return Err(self.invalid(format!(
-                            "trajectory.roll = {other:?}: expected \"zero\" or \"coordinated_turn\""
-                        )));
-                    }
-                };
-                let r = RecordedTrajectory::from_fixes(&fixes, &opts).map_err(sim_err)?;
-                (t0, t1, offset) = (r.start_s(), r.end_s(), 0.0);
-                traj = Box::new(r);
+                let r = self.recorded_motion(file, *position_cutoff_hz, roll.as_deref())?;
+                let (t0, t1) = (r.start_s(), r.end_s());
+                plain(Box::new(r), t0, t1, 0.0)
             }
             TrajectorySpec::Profile {
                 file,
@@ -477,40 +547,12 @@ impl Scenario {
                 gait,
                 segment,
             } => {
-                let profile = match (file, start) {
-                    (Some(f), None) => super::profile::MotionProfile::from_file(self.resolve(f))
-                        .map_err(sim_err)?,
-                    (None, Some(start)) => {
-                        let mut t = toml::Table::new();
-                        t.insert("start".into(), start.clone());
-                        if let Some(m) = mounting {
-                            t.insert("mounting".into(), m.clone());
-                        }
-                        if let Some(g) = gait {
-                            t.insert("gait".into(), g.clone());
-                        }
-                        t.insert(
-                            "segment".into(),
-                            toml::Value::Array(segment.clone().unwrap_or_default()),
-                        );
-                        let text = toml::to_string(&t)
-                            .map_err(|e| self.invalid(format!("trajectory: {e}")))?;
-                        super::profile::MotionProfile::from_toml_str(
-                            &text,
-                            &format!("{} [trajectory]", self.name),
-                        )
-                        .map_err(sim_err)?
-                    }
-                    _ => {
-                        return Err(self.invalid(
-                            "trajectory (profile): give `file` or an inline [trajectory.start] \
-                             with [[trajectory.segment]]s, not both",
-                        ));
-                    }
-                };
-                let lv = profile.build().map_err(sim_err)?;
-                (t0, t1, offset) = (0.0, lv.duration_s(), self.start_time_s);
-                traj = Box::new(lv);
+                let lv = self
+                    .profile_motion(file, start, mounting, gait, segment)?
+                    .build()
+                    .map_err(|e| self.sim_error(e))?;
+                let t1 = lv.duration_s();
+                plain(Box::new(lv), 0.0, t1, self.start_time_s)
             }
             TrajectorySpec::Static {
                 lat_deg,
@@ -549,8 +591,12 @@ impl Scenario {
                     c_bn,
                     omega_nb_b_rad_s: [0.0; 3],
                 };
-                (t0, t1, offset) = (0.0, *duration_s, self.start_time_s);
-                traj = Box::new(move |_t: f64| p);
+                plain(
+                    Box::new(move |_t: f64| p),
+                    0.0,
+                    *duration_s,
+                    self.start_time_s,
+                )
             }
             TrajectorySpec::Chamber(c) => {
                 if self.temperature.is_some() || self.gnss.is_some() {
@@ -560,124 +606,155 @@ impl Scenario {
                     ));
                 }
                 let mut c = c.clone();
-                c.sample_rate_hz = rate;
-                let proto = c.build().map_err(sens_err)?;
-                temperature = proto.temperature.clone();
-                (t0, t1, offset) = (0.0, proto.manifest.duration_s, self.start_time_s);
-                manifest = Some(proto.manifest.clone());
-                traj = Box::new(proto.trajectory);
+                c.sample_rate_hz = rate_hz;
+                let proto = c.build().map_err(|e| self.sensor_error(e))?;
+                Motion {
+                    t0: 0.0,
+                    t1: proto.manifest.duration_s,
+                    offset: self.start_time_s,
+                    manifest: Some(proto.manifest.clone()),
+                    temperature: proto.temperature.clone(),
+                    traj: Box::new(proto.trajectory),
+                }
             }
-        }
-        if !offset.is_finite() {
-            return Err(self.invalid("start_time_s must be finite"));
-        }
-        let n = ((t1 - t0) * rate + 1e-9).floor() as usize;
-        if n < 2 {
-            return Err(self.invalid(format!(
-                "the trajectory lasts {} s: fewer than two IMU samples at {rate} Hz",
-                t1 - t0
-            )));
-        }
-        let first = match self.imu.output {
-            OutputKind::Increments => t0 + dt,
-            OutputKind::Rates => t0,
-        };
-        let n = match self.imu.output {
-            OutputKind::Increments => n,
-            OutputKind::Rates => n + 1,
-        };
-        let curve = temperature.curve().map_err(sens_err)?;
-        let ideal = match &self.trajectory {
-            // A static IMU's ideal output is one constant: no per-sample evaluation.
-            TrajectorySpec::Static { .. } => {
-                let (w, f) = traj.point(t0).imu_rates();
-                IdealImu::constant(self.imu.output, first, dt, n, w, f)
-            }
-            _ => IdealImu::from_trajectory(&*traj, self.imu.output, first, dt, n),
-        };
-        let mut imu = model
-            .simulate(&ideal, &curve, self.seed)
-            .map_err(sens_err)?;
-        imu.first_time_s += offset;
-
-        // GNSS.
-        let (mut gnss, mut gnss_outages_s, mut lever) = (None, Vec::new(), [0.0; 3]);
-        if let Some(g) = &self.gnss {
-            let mut cfg = GnssSimConfig::new(g.rate_hz, t0, t1, 0.0);
-            cfg.sigma_ned_m = g.sigma_ned_m;
-            cfg.correlated_sigma_ned_m = g.correlated_sigma_ned_m;
-            if let Some(tau) = g.correlated_tau_s {
-                cfg.correlated_tau_s = tau;
-            }
-            cfg.velocity_sigma_ned_m_s = g.velocity_sigma_ned_m_s;
-            cfg.lever_arm_b_m = g.lever_arm_b_m;
-            if let Some(q) = g.quality {
-                cfg.quality = q;
-            }
-            cfg.reported_sigma_ned_m = g.reported_sigma_ned_m;
-            cfg.degraded_windows = g
-                .degraded_windows
-                .iter()
-                .map(|w| super::gnss::DegradedWindow {
-                    start_s: w.start_s + t0,
-                    end_s: w.end_s + t0,
-                    ..w.clone()
-                })
-                .collect();
-            cfg.time_offset_s = offset;
-            cfg.gps_week = self.gps_week;
-            // The first fix is at t0 (the start of the trajectory); 1 s margin at the end.
-            cfg.end_s = (t1 - 1e-6).max(t0);
-            if let Some(spec) = &g.outages {
-                let spec: OutageSpec = spec
-                    .parse()
-                    .map_err(|e| self.invalid(format!("gnss.outages: {e}")))?;
-                let windows = spec
-                    .resolve(TimeSpan {
-                        start_s: t0,
-                        end_s: cfg.end_s,
-                    })
-                    .map_err(|e| self.invalid(format!("gnss.outages: {e}")))?;
-                cfg.outages_s = windows.iter().map(|w| (w.start_s, w.end_s)).collect();
-                gnss_outages_s = cfg
-                    .outages_s
-                    .iter()
-                    .map(|&(a, b)| (a + offset, b + offset))
-                    .collect();
-            }
-            lever = g.lever_arm_b_m;
-            gnss = Some(simulate_gnss(&*traj, &cfg, self.seed ^ 0x9e37_79b9).map_err(sim_err)?);
-        }
-
-        // Truth.
-        let moving = matches!(
-            self.trajectory,
-            TrajectorySpec::Recorded { .. } | TrajectorySpec::Profile { .. }
-        );
-        let truth_rate =
-            self.output
-                .truth_rate_hz
-                .unwrap_or(if moving { rate } else { rate.min(1.0) });
-        if !(truth_rate.is_finite() && truth_rate > 0.0) {
-            return Err(self.invalid(format!(
-                "output.truth_rate_hz must be > 0, got {truth_rate}"
-            )));
-        }
-        let nt = ((t1 - t0) * truth_rate + 1e-9).floor() as usize + 1;
-        let truth = truth_solution(&*traj, t0, 1.0 / truth_rate, nt, offset);
-        let mut initial = traj.point(t0).nav_state(t0 + offset);
-        initial.q_bn = initial.q_bn.normalized();
-        Ok(Simulation {
-            imu,
-            gnss,
-            gnss_outages_s,
-            truth,
-            initial,
-            sensor,
-            manifest,
-            lever_arm_b_m: lever,
         })
     }
+
+    /// A trajectory from a recorded GNSS track (`[trajectory] file = …`).
+    fn recorded_motion(
+        &self,
+        file: &Path,
+        position_cutoff_hz: Option<f64>,
+        roll: Option<&str>,
+    ) -> Result<RecordedTrajectory, ScenarioError> {
+        let path = self.resolve(file);
+        let fixes = crate::nav::pipeline::read_gnss_file(&path, &GnssReadOptions::default())
+            .map_err(|e| self.invalid(format!("trajectory.file: {e}")))?;
+        let mut opts = RecordedOptions::default();
+        if let Some(f) = position_cutoff_hz {
+            opts.position_cutoff_hz = f;
+        }
+        opts.roll = match roll {
+            None | Some("zero") => RollModel::Zero,
+            Some("coordinated_turn") => RollModel::CoordinatedTurn,
+            Some(other) => {
+                return Err(self.invalid(format!(
+                    "trajectory.roll = {other:?}: expected \"zero\" or \"coordinated_turn\""
+                )));
+            }
+        };
+        RecordedTrajectory::from_fixes(&fixes, &opts).map_err(|e| self.sim_error(e))
+    }
+
+    /// A motion profile from its file or the inline `[trajectory]` tables.
+    fn profile_motion(
+        &self,
+        file: &Option<PathBuf>,
+        start: &Option<toml::Value>,
+        mounting: &Option<toml::Value>,
+        gait: &Option<toml::Value>,
+        segment: &Option<Vec<toml::Value>>,
+    ) -> Result<super::profile::MotionProfile, ScenarioError> {
+        match (file, start) {
+            (Some(f), None) => super::profile::MotionProfile::from_file(self.resolve(f))
+                .map_err(|e| self.sim_error(e)),
+            (None, Some(start)) => {
+                let mut t = toml::Table::new();
+                t.insert("start".into(), start.clone());
+                if let Some(m) = mounting {
+                    t.insert("mounting".into(), m.clone());
+                }
+                if let Some(g) = gait {
+                    t.insert("gait".into(), g.clone());
+                }
+                t.insert(
+                    "segment".into(),
+                    toml::Value::Array(segment.clone().unwrap_or_default()),
+                );
+                let text =
+                    toml::to_string(&t).map_err(|e| self.invalid(format!("trajectory: {e}")))?;
+                super::profile::MotionProfile::from_toml_str(
+                    &text,
+                    &format!("{} [trajectory]", self.name),
+                )
+                .map_err(|e| self.sim_error(e))
+            }
+            _ => Err(self.invalid(
+                "trajectory (profile): give `file` or an inline [trajectory.start] \
+                 with [[trajectory.segment]]s, not both",
+            )),
+        }
+    }
+
+    /// The GNSS fixes of the `[gnss]` table along `traj` over \[t0, t1\], and the outage
+    /// windows on output time (`offset` added).
+    fn gnss_fixes(
+        &self,
+        g: &GnssSpec,
+        traj: &(dyn Trajectory + Sync),
+        t0: f64,
+        t1: f64,
+        offset: f64,
+    ) -> Result<(GnssFixes, Vec<(f64, f64)>), ScenarioError> {
+        let mut cfg = GnssSimConfig::new(g.rate_hz, t0, t1, 0.0);
+        cfg.sigma_ned_m = g.sigma_ned_m;
+        cfg.correlated_sigma_ned_m = g.correlated_sigma_ned_m;
+        if let Some(tau) = g.correlated_tau_s {
+            cfg.correlated_tau_s = tau;
+        }
+        cfg.velocity_sigma_ned_m_s = g.velocity_sigma_ned_m_s;
+        cfg.lever_arm_b_m = g.lever_arm_b_m;
+        if let Some(q) = g.quality {
+            cfg.quality = q;
+        }
+        cfg.reported_sigma_ned_m = g.reported_sigma_ned_m;
+        cfg.degraded_windows = g
+            .degraded_windows
+            .iter()
+            .map(|w| super::gnss::DegradedWindow {
+                start_s: w.start_s + t0,
+                end_s: w.end_s + t0,
+                ..w.clone()
+            })
+            .collect();
+        cfg.time_offset_s = offset;
+        cfg.gps_week = self.gps_week;
+        // The first fix is at t0 (the start of the trajectory); 1 s margin at the end.
+        cfg.end_s = (t1 - 1e-6).max(t0);
+        let mut outages_s = Vec::new();
+        if let Some(spec) = &g.outages {
+            let spec: OutageSpec = spec
+                .parse()
+                .map_err(|e| self.invalid(format!("gnss.outages: {e}")))?;
+            let windows = spec
+                .resolve(TimeSpan {
+                    start_s: t0,
+                    end_s: cfg.end_s,
+                })
+                .map_err(|e| self.invalid(format!("gnss.outages: {e}")))?;
+            cfg.outages_s = windows.iter().map(|w| (w.start_s, w.end_s)).collect();
+            outages_s = cfg
+                .outages_s
+                .iter()
+                .map(|&(a, b)| (a + offset, b + offset))
+                .collect();
+        }
+        let fixes =
+            simulate_gnss(traj, &cfg, self.seed ^ 0x9e37_79b9).map_err(|e| self.sim_error(e))?;
+        Ok((fixes, outages_s))
+    }
+}
+
+/// A scenario's motion: the trajectory on its own clock over \[`t0`, `t1`\] s, the offset
+/// added to put it on output time, the chamber protocol's manifest when there is one, and
+/// the temperature the sensor sees.
+struct Motion {
+    traj: Box<dyn Trajectory + Sync>,
+    t0: f64,
+    t1: f64,
+    offset: f64,
+    manifest: Option<ChamberManifest>,
+    temperature: TemperatureProfile,
 }
 
 /// Truth samples t0 + k·dt (k < n) as a navigation solution on output time.
