@@ -85,7 +85,9 @@ pub(crate) fn decompress(
         ));
     }
     out.clear();
-    out.reserve(usize::try_from(declared.unwrap_or(0)).unwrap_or(0));
+    // Reserve what is declared only up to a few MiB: a corrupt header must not make a
+    // large allocation before the data shows it decompresses that far.
+    out.reserve(usize::try_from(declared.unwrap_or(0).min(4 << 20)).unwrap_or(0));
     let fail = |e: std::io::Error| format!("{} data does not decompress: {e}", codec.name());
     // Read one byte past the declared size, to tell a lying header from an exact one.
     let limit = cap + 1;
