@@ -152,14 +152,15 @@ pub fn read_rosbag_parts(
     // Pass 1: the topics.
     let mut topics = Topics::default();
     for (p, part) in parts.iter_mut().enumerate() {
-        part.scan(&mut |item| {
+        part.scan(true, &mut |item| {
             match item {
                 Item::Connection {
                     id,
                     topic,
                     msg_type,
                 } => topics.add((p, id), topic, msg_type),
-                Item::Message { conn, .. } => topics.count((p, conn)),
+                Item::Message { conn, .. } => topics.count((p, conn), 1),
+                Item::Count { conn, messages } => topics.count((p, conn), messages),
             }
             Ok(())
         })?;
@@ -176,7 +177,7 @@ pub fn read_rosbag_parts(
             BagFormat::Ros1 => Encoding::Ros1,
             _ => Encoding::Cdr,
         };
-        part.scan(&mut |item| {
+        part.scan(false, &mut |item| {
             let Item::Message {
                 conn,
                 byte_offset,
@@ -278,9 +279,11 @@ impl<'n> Part<'n> {
         })
     }
 
-    /// Reads the file from its start, handing on connections and messages in stored order.
+    /// Reads the file from its start, handing on connections and messages in stored order
+    /// (`topics_only`: messages may be handed on as counts instead).
     fn scan(
         &mut self,
+        topics_only: bool,
         visit: &mut dyn FnMut(Item<'_>) -> Result<(), LogError>,
     ) -> Result<(), LogError> {
         if self.format == BagFormat::Sqlite3 {
@@ -294,7 +297,7 @@ impl<'n> Part<'n> {
             })?;
         let mut src = Source::new(&mut self.file, self.name, self.size);
         match self.format {
-            BagFormat::Ros1 => ros1::scan(&mut src, visit),
+            BagFormat::Ros1 => ros1::scan(&mut src, topics_only, visit),
             _ => mcap::scan(&mut src, visit),
         }
     }
@@ -308,6 +311,9 @@ pub(crate) enum Item<'a> {
         topic: &'a str,
         msg_type: &'a str,
     },
+    /// How many messages a connection has in one chunk, from a ROS 1 index (when the
+    /// messages themselves are not read: [`Part::scan`]'s `topics_only`).
+    Count { conn: u32, messages: u64 },
     /// One message: its connection, the byte offset of its record (for errors; within a
     /// chunk, the chunk's offset) and its serialized bytes.
     Message {
@@ -360,7 +366,7 @@ type ConnKey = (usize, u32);
 #[derive(Default)]
 struct Topics {
     /// (topic, type, kind, messages).
-    list: Vec<(String, String, Kind, usize)>,
+    list: Vec<(String, String, Kind, u64)>,
     /// ((storage file, connection id), index into `list`).
     conns: Vec<(ConnKey, usize)>,
 }
@@ -390,9 +396,9 @@ impl Topics {
             .find(|&&(c, _)| c == conn)
             .map(|&(_, i)| i)
     }
-    fn count(&mut self, conn: ConnKey) {
+    fn count(&mut self, conn: ConnKey, messages: u64) {
         if let Some(i) = self.topic_of(conn) {
-            self.list[i].3 += 1;
+            self.list[i].3 += messages;
         }
     }
     fn name(&self, i: usize) -> &str {

@@ -137,8 +137,14 @@ fn record(
 }
 
 /// Reads the bag front to back, handing on connections and messages in file order.
+///
+/// With `topics_only`, a bag whose header points to an index section (`index_pos` ≠ 0: the
+/// recording was closed) is read without opening its chunks: the index section repeats
+/// every connection record, and each chunk-info record counts the chunk's messages per
+/// connection ([`Item::Count`]), so a compressed bag is decompressed once, not twice.
 pub(crate) fn scan(
     src: &mut Source<'_>,
+    topics_only: bool,
     visit: &mut dyn FnMut(Item<'_>) -> Result<(), LogError>,
 ) -> Result<(), LogError> {
     let mut buf = Vec::new();
@@ -163,6 +169,7 @@ pub(crate) fn scan(
     let mut header = Vec::new();
     let mut body = Vec::new();
     let mut plain = Vec::new();
+    let mut indexed = false;
     while src.remaining() > 0 {
         let record_at = src.pos;
         src.read_into(FORMAT, record_at, 4, "a record's header length", &mut buf)?;
@@ -178,6 +185,29 @@ pub(crate) fn scan(
         let dlen = le_u32(&buf, 0).unwrap_or(0);
         let op = op_of(&header).map_err(|m| src.error(FORMAT, record_at, m))?;
         match op {
+            OP_CHUNK if topics_only && indexed => {
+                src.skip(FORMAT, record_at, dlen.into(), "a chunk")?;
+            }
+            OP_CHUNK_INFO if topics_only && indexed => {
+                src.read_into(FORMAT, record_at, dlen.into(), "a record's data", &mut body)?;
+                let err = |m: String| src.error(FORMAT, record_at, format!("chunk info: {m}"));
+                let n = u32_field(&header, "count").map_err(err)?;
+                for k in 0..n as usize {
+                    let pair = body
+                        .get(8 * k..8 * k + 8)
+                        .ok_or_else(|| err(format!("{n} connections, data of {dlen} bytes")))?;
+                    visit(Item::Count {
+                        conn: le_u32(pair, 0).unwrap_or(0),
+                        messages: le_u32(pair, 4).unwrap_or(0).into(),
+                    })?;
+                }
+            }
+            OP_BAG_HEADER => {
+                if let Ok(Some(pos)) = field(&header, b"index_pos") {
+                    indexed = pos.len() == 8 && pos.iter().any(|&b| b != 0);
+                }
+                src.skip(FORMAT, record_at, dlen.into(), "a record's data")?;
+            }
             OP_CHUNK => {
                 let chunk_err = |src: &Source<'_>, m: String| {
                     src.error(FORMAT, record_at, format!("chunk: {m}"))
@@ -204,7 +234,7 @@ pub(crate) fn scan(
                     Failure::Error(e) => *e,
                 })?;
             }
-            OP_INDEX | OP_CHUNK_INFO | OP_BAG_HEADER => {
+            OP_INDEX | OP_CHUNK_INFO => {
                 src.skip(FORMAT, record_at, dlen.into(), "a record's data")?;
             }
             op => {

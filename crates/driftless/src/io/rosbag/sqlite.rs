@@ -475,12 +475,16 @@ impl<'f> Db<'f> {
                 .get(ptr_at..ptr_at + 2)
                 .map(|p| usize::from(u16::from_be_bytes([p[0], p[1]])))
                 .ok_or_else(|| page_err("cell pointer array runs past the page".into()))?;
-            let at = base + cell as u64;
-            let cell_err = |m: String| error_at(name, at, format!("page {pgno} cell {i}: {m}"));
             let body = page
                 .get(cell..usable)
                 .filter(|_| cell >= head + 8)
-                .ok_or_else(|| cell_err(format!("offset {cell} outside the page")))?;
+                .ok_or_else(|| {
+                    // Reported at its pointer: the offset itself may lie past the file.
+                    let m = format!("page {pgno} cell {i}: offset {cell} outside the page");
+                    error_at(name, base + ptr_at as u64, m)
+                })?;
+            let at = base + cell as u64;
+            let cell_err = |m: String| error_at(name, at, format!("page {pgno} cell {i}: {m}"));
             let (p, n1) = varint(body).ok_or_else(|| cell_err("payload size cut off".into()))?;
             let (rowid, n2) =
                 varint(&body[n1..]).ok_or_else(|| cell_err("rowid cut off".into()))?;
@@ -708,6 +712,24 @@ mod tests {
         looped[512..524].copy_from_slice(&[5, 0, 0, 0, 0, 2, 0, 0, 0, 0, 0, 2]);
         let e = rows_of(&looped, "loop").unwrap_err().to_string();
         assert!(e.contains("page loop"), "{e}");
+        // A cell pointer past the end of its page (and of the file): reported at the
+        // pointer (page 2 at byte 512, its first pointer 8 bytes in).
+        let mut wild = file.clone();
+        wild[520..522].copy_from_slice(&0xfff6u16.to_be_bytes());
+        match rows_of(&wild, "wild") {
+            Err(LogError::AtByte {
+                byte_offset,
+                message,
+                ..
+            }) => {
+                assert_eq!(byte_offset, 520);
+                assert!(
+                    message.contains("offset 65526 outside the page"),
+                    "{message}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
         // The header declaring more pages than the file holds.
         let mut short = file.clone();
         short[28..32].copy_from_slice(&9u32.to_be_bytes());
