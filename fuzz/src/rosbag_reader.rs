@@ -1,6 +1,9 @@
-//! Arbitrary bytes into the ROS 1 bag / MCAP reader (the seeds are short bags written by
-//! the Python `rosbags` package): no panic, no huge allocation, an error's byte offset
-//! inside the input, and a log's channels of equal length, finite, in increasing time.
+//! Arbitrary bytes into the ROS 1 bag / MCAP / sqlite3 bag reader (the seeds are short
+//! bags written by the Python `rosbags` package, uncompressed and with bz2 / lz4 ROS 1
+//! chunks and zstd / lz4 MCAP chunks, and a 512-byte-page `.db3` written by Python's
+//! `sqlite3` with rosbag2's tables and rosbags' CDR messages, one row in an overflow page):
+//! no panic, no huge allocation, an error's byte offset inside the input, and a log's
+//! channels of equal length, finite, in increasing time.
 //! The reader takes a file (it reads the bag twice), so each input is written to a
 //! temporary file first.
 

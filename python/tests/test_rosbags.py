@@ -1,6 +1,7 @@
-"""ROS 1 bags and ROS 2 MCAP bags written by the `rosbags` package (make_bags.py) read by
+"""ROS 1 bags, ROS 2 MCAP and sqlite3 bags written by the `rosbags` package (make_bags.py),
+uncompressed and with each chunk / message compression it writes, read by
 `driftless allan … --topic /imu`: the Allan results equal those of the same samples as
-CSV, bit for bit; the error cases name the topics, the message or the byte offset."""
+CSV; the error cases name the topics, the message or the byte offset."""
 
 import json
 import os
@@ -54,7 +55,12 @@ def assert_close(got, want, path="", rel=1e-9):
         assert got == want, (path, got, want)
 
 
-@pytest.mark.parametrize("bag", ["imu.bag", "imu_mcap", "imu_mcap/imu_mcap.mcap"])
+ALL_BAGS = ["imu.bag", "imu_mcap", "imu_mcap/imu_mcap.mcap", "imu_db3", "imu_db3/imu_db3.db3",
+            "imu_bz2.bag", "imu_lz4.bag", "imu_mcap_zstd", "imu_mcap_lz4", "imu_db3_msg",
+            "imu_db3_split"]
+
+
+@pytest.mark.parametrize("bag", ALL_BAGS)
 def test_bag_equals_csv(bags, bag):
     want = results(bags / "imu.csv")
     names = [c["name"] for c in want["channels"]]
@@ -66,7 +72,9 @@ def test_bag_equals_csv(bags, bag):
     assert results(bags / bag) == got
 
 
-@pytest.mark.parametrize("bag", ["imu.bag", "imu_mcap"])
+@pytest.mark.parametrize("bag", ["imu.bag", "imu_mcap", "imu_db3", "imu_bz2.bag", "imu_lz4.bag",
+                                 "imu_mcap_zstd", "imu_mcap_lz4", "imu_db3_msg",
+                                 "imu_db3_split"])
 def test_samples_and_nearest_temperature_equal_the_csv(bags, tmp_path, bag):
     out = tmp_path / "out.csv"
     subprocess.run([BIN, "convert", str(bags / bag), str(out), "--topic", "/imu", "--quiet"],
@@ -96,18 +104,50 @@ def test_missing_topic_lists_the_topics(bags):
     assert rc != 0 and "not sensor_msgs/Imu" in err, err
 
 
-def test_unordered_stamps_name_the_message(bags):
-    rc, _, err = allan(bags / "unordered.bag")
+@pytest.mark.parametrize("bag", ["unordered.bag", "unordered_db3"])
+def test_unordered_stamps_name_the_message(bags, bag):
+    rc, _, err = allan(bags / bag)
     assert rc != 0
     assert "IMU message 11" in err and "message 10" in err and "@byte " in err, err
 
 
-def test_sqlite3_bag_is_refused_with_the_conversion(bags):
-    rc, _, err = allan(bags / "imu_db3")
-    assert rc != 0 and "sqlite3" in err and "rosbags-convert" in err, err
+def test_rows_in_overflow_pages_read_alike(bags):
+    """5-kB messages (each row spilling into SQLite overflow pages) give the samples of the
+    same messages in MCAP."""
+    assert results(bags / "long_rows_db3") == results(bags / "short_mcap")
 
 
-@pytest.mark.parametrize("bag", ["imu.bag", "imu_mcap/imu_mcap.mcap"])
+def test_file_compressed_bag_names_the_decompression(bags):
+    rc, _, err = allan(bags / "file_zstd_db3")
+    assert rc == 1 and "file-compressed" in err and "zstd -d" in err, err
+
+
+def test_unfinished_sqlite3_bag_is_an_error(bags, tmp_path):
+    """A bag still open for writing in WAL mode (committed rows only in the -wal file)."""
+    import shutil
+    import sqlite3
+    db = tmp_path / "open.db3"
+    shutil.copy(bags / "imu_db3" / "imu_db3.db3", db)
+    conn = sqlite3.connect(db)
+    try:
+        conn.execute("PRAGMA journal_mode=WAL")
+        conn.execute("INSERT INTO messages (topic_id, timestamp, data) "
+                     "SELECT topic_id, timestamp + 1, data FROM messages WHERE id = 1")
+        conn.commit()
+        assert (tmp_path / "open.db3-wal").stat().st_size > 0
+        rc, _, err = allan(db)
+        assert rc == 1 and "open.db3-wal" in err and "did not close" in err, err
+    finally:
+        conn.close()
+    # Closed, SQLite has moved the rows into the database: it reads.
+    assert not (tmp_path / "open.db3-wal").exists()
+    rc, _, err = allan(db)
+    assert rc != 0 and "IMU message" in err, err  # the appended copy repeats a stamp
+
+
+@pytest.mark.parametrize("bag", ["imu.bag", "imu_mcap/imu_mcap.mcap", "imu_db3/imu_db3.db3",
+                                 "imu_bz2.bag", "imu_lz4.bag", "imu_mcap_zstd/imu_mcap_zstd.mcap",
+                                 "imu_mcap_lz4/imu_mcap_lz4.mcap"])
 def test_truncated_bags_name_the_byte_offset(bags, tmp_path, bag):
     data = (bags / bag).read_bytes()
     for frac in [0.001, 0.3, 0.77, 0.999]:
@@ -121,7 +161,8 @@ def test_truncated_bags_name_the_byte_offset(bags, tmp_path, bag):
 def test_mutated_bags_never_panic(bags, tmp_path):
     import random
     rng = random.Random(3)
-    for bag in ["imu.bag", "imu_mcap/imu_mcap.mcap"]:
+    for bag in ["imu.bag", "imu_mcap/imu_mcap.mcap", "imu_db3/imu_db3.db3", "imu_bz2.bag",
+                "imu_lz4.bag", "imu_mcap_zstd/imu_mcap_zstd.mcap"]:
         data = bytearray((bags / bag).read_bytes()[:300_000])
         for _ in range(20):
             m = bytearray(data)

@@ -14,8 +14,9 @@ pub struct InputArgs {
     /// IMU instance to take from a PX4 ULog (`.ulg`) or ArduPilot DataFlash (`.bin`) log.
     #[arg(long, value_name = "N", default_value_t = 0, value_parser = crate::numbers::whole::<u8>, allow_hyphen_values = true)]
     pub instance: u8,
-    /// `sensor_msgs/Imu` topic to take from a ROS 1 bag (`.bag`), an MCAP file or a ROS 2
-    /// bag folder (default: the bag's only IMU topic).
+    /// `sensor_msgs/Imu` topic to take from a ROS 1 bag (`.bag`; bz2/lz4 chunks too), a ROS 2
+    /// MCAP (`.mcap`; zstd/lz4 chunks too) or sqlite3 (`.db3`) file, or a ROS 2 bag folder
+    /// (metadata.yaml; split bags read in order) (default: the bag's only IMU topic).
     #[arg(long, value_name = "TOPIC")]
     pub topic: Option<String>,
     /// Sample rate in Hz (required when the file has no time column).
@@ -116,7 +117,7 @@ impl InputArgs {
         } else {
             if let Some(t) = &self.topic {
                 anyhow::bail!(
-                    "{}: --topic {t} is for ROS bags and MCAP files; this input is not one",
+                    "{}: --topic {t} is for ROS bags (.bag, .mcap, .db3); this input is not one",
                     path.display()
                 );
             }

@@ -43,19 +43,21 @@ pub struct LogInput {
     file: std::fs::File,
     /// Size in bytes when the input is a regular file (pipes, FIFOs and devices have none).
     size: Option<u64>,
+    /// The ROS 2 bag folder the input was opened from (its first storage file is `file`).
+    folder: Option<super::rosbag::Ros2BagFolder>,
 }
 
 impl LogInput {
     /// Opens `path` and reads its first bytes. Errors name the file.
     pub fn open(path: impl AsRef<Path>) -> Result<LogInput, LogError> {
         let mut path = path.as_ref();
-        // A ROS 2 bag is a folder: its metadata.yaml and one storage file.
-        let storage = if path.is_dir() {
-            super::rosbag::storage_file_in(path)?
+        // A ROS 2 bag is a folder: its metadata.yaml and its storage files.
+        let folder = if path.is_dir() {
+            super::rosbag::ros2_bag_folder(path)?
         } else {
             None
         };
-        if let Some(p) = &storage {
+        if let Some(p) = folder.as_ref().and_then(|f| f.storage.first()) {
             path = p;
         }
         let name = path.display().to_string();
@@ -76,6 +78,7 @@ impl LogInput {
             head,
             file,
             size,
+            folder,
         })
     }
 
@@ -147,15 +150,15 @@ impl LogInput {
         Ok(bytes)
     }
 
-    /// Whether the input is a ROS bag or MCAP file (by its magic bytes).
+    /// Whether the input is a ROS bag, MCAP file or sqlite3 bag (by its magic bytes).
     pub fn is_rosbag(&self) -> bool {
         matches!(self.format(), InputFormat::RosBag(_))
     }
 
-    /// Reads the IMU topic `topic` of a ROS bag or MCAP file (without one, its only IMU
-    /// topic); see [`super::rosbag`].
+    /// Reads the IMU topic `topic` of a ROS bag, MCAP file, sqlite3 bag or ROS 2 bag folder
+    /// (without one, its only IMU topic); see [`super::rosbag`].
     pub fn read_rosbag(self, topic: Option<&str>) -> Result<ImuLog, LogError> {
-        super::rosbag::read_rosbag(self.file, &self.name, topic)
+        super::rosbag::read_rosbag_parts(self.file, &self.name, self.folder.as_ref(), topic)
     }
 
     /// Whether the input is a PX4 ULog or ArduPilot DataFlash log (by its magic bytes).

@@ -6,8 +6,8 @@
 //! * [`write`](mod@write): CSV writer.
 //! * [`ulog`], [`dataflash`], [`autopilot`] (feature `autopilot-logs`, on by default): PX4
 //!   ULog and ArduPilot DataFlash logs → one [`log::ImuLog`] per IMU instance.
-//! * [`rosbag`]: ROS 1 bags and MCAP files (ROS 2) → the [`log::ImuLog`] of one
-//!   `sensor_msgs/Imu` topic.
+//! * [`rosbag`]: ROS 1 bags, ROS 2 MCAP and sqlite3 (`.db3`) bags, compressed chunks
+//!   included → the [`log::ImuLog`] of one `sensor_msgs/Imu` topic.
 //! * [`units`]: unit strings → SI conversion.
 //! * [`error`]: one error type, [`LogError`], naming file, line and column.
 //! * [`input`]: an input opened once and sniffed on the handle that is then read (pipes
@@ -54,7 +54,7 @@ pub use binary::{read_binary, read_binary_file, write_binary, write_binary_file}
 pub use error::{Location, LogError};
 pub use input::{InputFormat, LogInput, MAX_CONFIG_BYTES, read_config_text};
 pub use log::{Channel, ImuLog, Quantity, TimeGap};
-pub use rosbag::{BagFormat, read_rosbag_file};
+pub use rosbag::{BagFormat, Ros2BagFolder, read_rosbag_file};
 pub use text::{
     ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, TextOptions, read_text,
     read_text_bytes, read_text_file,

@@ -4,6 +4,7 @@
 //! (0x05) sit in the data section directly or inside chunks (0x06). The summary section
 //! repeats schemas and channels.
 
+use super::compress::{self, Codec};
 use super::{Item, Source, le_u16, le_u32, le_u64};
 use crate::io::error::LogError;
 
@@ -81,17 +82,20 @@ fn record(
     }
 }
 
-/// The records of an uncompressed chunk's `records`, which start at file offset `base`.
+/// The records of a chunk's `records`, which start at file offset `base`; for a
+/// decompressed chunk (`compressed`), `base` is the chunk record's offset and every record
+/// inside is reported there.
 fn records_in_chunk(
     src: &Source<'_>,
     data: &[u8],
     base: u64,
+    compressed: bool,
     schemas: &mut Schemas,
     visit: &mut dyn FnMut(Item<'_>) -> Result<(), LogError>,
 ) -> Result<(), LogError> {
     let mut at = 0usize;
     while at < data.len() {
-        let record_at = base + at as u64;
+        let record_at = if compressed { base } else { base + at as u64 };
         let err = |m: String| src.error(FORMAT, record_at, m);
         let op = data[at];
         let len = le_u64(data, at + 1)
@@ -122,6 +126,7 @@ pub(crate) fn scan(
     }
     let mut schemas = Schemas::default();
     let mut content = Vec::new();
+    let mut plain = Vec::new();
     loop {
         let record_at = src.pos;
         if src.remaining() == 0 {
@@ -160,17 +165,8 @@ pub(crate) fn scan(
                 let content_at = record_at + 9;
                 let (compression, next) =
                     string_at(&content, 28).map_err(|m| err(src, format!("chunk: {m}")))?;
-                if !compression.is_empty() {
-                    return Err(err(
-                        src,
-                        format!(
-                            "{compression}-compressed chunk: compressed MCAP chunks are not \
-                             read; rewrite the file uncompressed (`mcap compress \
-                             --compression none`, or rosbags' writer without storage \
-                             compression)"
-                        ),
-                    ));
-                }
+                let codec = Codec::of(compression, &[Codec::Zstd, Codec::Lz4])
+                    .map_err(|m| err(src, format!("chunk: {m}")))?;
                 let n = le_u64(&content, next)
                     .and_then(|l| usize::try_from(l).ok())
                     .ok_or_else(|| err(src, "chunk records length cut off".into()))?;
@@ -182,13 +178,24 @@ pub(crate) fn scan(
                             format!("chunk records of {n} bytes run past the chunk"),
                         )
                     })?;
-                records_in_chunk(
-                    src,
-                    records,
-                    content_at + (next + 8) as u64,
-                    &mut schemas,
-                    visit,
-                )?;
+                match codec {
+                    None => records_in_chunk(
+                        src,
+                        records,
+                        content_at + (next + 8) as u64,
+                        false,
+                        &mut schemas,
+                        visit,
+                    )?,
+                    Some(codec) => {
+                        // Chunk: message_start_time u64, message_end_time u64,
+                        // uncompressed_size u64, uncompressed_crc u32, compression, records.
+                        let size = le_u64(&content, 16).unwrap_or(0);
+                        compress::decompress(codec, records, Some(size), &mut plain)
+                            .map_err(|m| err(src, format!("chunk: {m}")))?;
+                        records_in_chunk(src, &plain, record_at, true, &mut schemas, visit)?;
+                    }
+                }
             }
             _ => src.skip(FORMAT, record_at, len, "a record")?,
         }

@@ -1,5 +1,6 @@
-//! Robotics logs: IMU messages from ROS 1 bags (`.bag`, format 2.0) and ROS 2 MCAP bags
-//! (`.mcap`, or a ROS 2 bag folder with `metadata.yaml`) → one [`ImuLog`].
+//! Robotics logs: IMU messages from ROS 1 bags (`.bag`, format 2.0), ROS 2 MCAP bags
+//! (`.mcap`) and ROS 2 sqlite3 bags (`.db3`), or a ROS 2 bag folder (`metadata.yaml` naming
+//! one or more storage files, read in that order as one recording) → one [`ImuLog`].
 //!
 //! * The topic is chosen by name ([`read_rosbag_file`]'s `topic`); without one, a bag with
 //!   exactly one `sensor_msgs/Imu` topic uses it, any other count is an error listing the
@@ -10,28 +11,38 @@
 //!   `linear_acceleration`) and `temperature` (°C): the units of `sensor_msgs`, so nothing is
 //!   converted. Orientation and covariances are read past, not kept.
 //! * `time_s` is the header stamp, `sec + nanosec · 1e-9` s (not zero-based). The messages
-//!   must come in strictly increasing header-stamp order as stored in the bag: a repeated or
-//!   earlier stamp is an error naming the message's index, byte offset and both stamps
-//!   (never silently sorted: an IMU driver stamps in order, so disorder is a recording fault
-//!   the user should see).
+//!   must come in strictly increasing header-stamp order as stored in the bag (file order;
+//!   rowid order in a `.db3`, i.e. the order they were recorded): a repeated or earlier
+//!   stamp is an error naming the message's index, byte offset and both stamps (never
+//!   silently sorted: an IMU driver stamps in order, so disorder is a recording fault the
+//!   user should see).
 //! * `tau0_s` is the median stamp interval, taken from the integer nanosecond stamps (epoch
 //!   seconds as f64 are quantised to ≈ 0.24 µs); intervals over 1.5 τ0 are listed in
 //!   [`ImuLog::gaps`] while the log stays one segment, as for autopilot logs.
 //! * Streamed: the bag is read twice (once for its topics, once for the messages), one
-//!   record or chunk at a time, so the memory beyond the output columns is one chunk
-//!   (≈ 1 MiB as written by ROS tools) whatever the bag's length.
-//! * Compressed chunks (ROS 1 `bz2`/`lz4`, MCAP `zstd`/`lz4`) and ROS 2 sqlite3 bags (`.db3`)
-//!   are refused with an error naming the compression or storage and how to convert.
+//!   record, chunk or SQLite page at a time, so the memory beyond the output columns is one
+//!   chunk (≈ 1 MiB as written by ROS tools) or one B-tree path of pages, whatever the
+//!   bag's length.
+//! * Compressed chunks are decompressed one at a time: ROS 1 `bz2` and `lz4`, MCAP `zstd`
+//!   and `lz4`; rosbag2's per-message `zstd` compression
+//!   (`compression_mode: message` in `metadata.yaml`) likewise. A whole-file compressed bag
+//!   (`compression_mode: file`, `*.db3.zstd`) is refused with the command that decompresses
+//!   it.
 
 mod cdr;
+mod compress;
+mod db3;
+mod folder;
 mod mcap;
 mod ros1;
+mod sqlite;
 
 use std::io::{BufReader, Read, Seek, SeekFrom};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::error::{Location, LogError};
 use super::log::{Channel, ImuLog, Quantity};
+pub use folder::{Ros2BagFolder, ros2_bag_folder};
 
 /// Which robotics log format an input holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,7 +51,7 @@ pub enum BagFormat {
     Ros1,
     /// MCAP (ROS 2 default storage since Iron), CDR-encoded messages.
     Mcap,
-    /// ROS 2 sqlite3 storage (`.db3`): recognised, not read.
+    /// ROS 2 sqlite3 storage (`.db3`).
     Sqlite3,
 }
 
@@ -77,176 +88,219 @@ pub fn detect_format(head: &[u8]) -> Option<BagFormat> {
     }
 }
 
-/// The storage file of a ROS 2 bag folder (one holding `metadata.yaml`): its one `.mcap` or
-/// `.db3` file. `None` when `dir` holds no `metadata.yaml`; an error when it holds no storage
-/// file or several (a split bag).
-pub fn storage_file_in(dir: &Path) -> Result<Option<PathBuf>, LogError> {
-    if !dir.join("metadata.yaml").is_file() {
-        return Ok(None);
-    }
-    let name = dir.display().to_string();
-    let entries = std::fs::read_dir(dir).map_err(|error| LogError::Io {
-        path: name.clone(),
-        error,
-    })?;
-    let mut found: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.is_file() && p.extension().is_some_and(|x| x == "mcap" || x == "db3"))
-        .collect();
-    found.sort();
-    match found.len() {
-        1 => Ok(found.pop()),
-        0 => Err(LogError::InvalidOptions {
-            at: Location::input(&name),
-            message: "a ROS 2 bag folder (metadata.yaml) without a .mcap or .db3 file".into(),
-        }),
-        _ => Err(LogError::InvalidOptions {
-            at: Location::input(&name),
-            message: format!(
-                "a split ROS 2 bag ({} storage files: {}); give one of the files",
-                found.len(),
-                found
-                    .iter()
-                    .filter_map(|p| p.file_name().map(|f| f.to_string_lossy().into_owned()))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        }),
-    }
-}
-
 /// Reads the IMU topic `topic` (or the bag's only IMU topic) of the ROS bag at `path` (a
-/// `.bag`, `.mcap`, or a ROS 2 bag folder). See the module doc for the conventions.
+/// `.bag`, `.mcap`, `.db3`, or a ROS 2 bag folder). See the module doc for the conventions.
 pub fn read_rosbag_file(path: impl AsRef<Path>, topic: Option<&str>) -> Result<ImuLog, LogError> {
-    let mut path = path.as_ref().to_path_buf();
-    if path.is_dir()
-        && let Some(p) = storage_file_in(&path)?
-    {
-        path = p;
-    }
-    let name = path.display().to_string();
-    let file = std::fs::File::open(&path).map_err(|error| LogError::Io {
+    let path = path.as_ref();
+    let folder = if path.is_dir() {
+        ros2_bag_folder(path)?
+    } else {
+        None
+    };
+    let first = folder
+        .as_ref()
+        .and_then(|f| f.storage.first())
+        .map_or(path, |p| p.as_path());
+    let name = first.display().to_string();
+    let file = std::fs::File::open(first).map_err(|error| LogError::Io {
         path: name.clone(),
         error,
     })?;
-    read_rosbag(file, &name, topic)
+    read_rosbag_parts(file, &name, folder.as_ref(), topic)
 }
 
 /// [`read_rosbag_file`] of an opened file (read from its start; it must be seekable: the
 /// bag is read twice).
 pub fn read_rosbag(
-    mut file: std::fs::File,
+    file: std::fs::File,
     name: &str,
     topic: Option<&str>,
 ) -> Result<ImuLog, LogError> {
-    let io = |error| LogError::Io {
-        path: name.to_owned(),
-        error,
-    };
-    let meta = file.metadata().map_err(io)?;
-    if !meta.is_file() {
-        return Err(LogError::InvalidOptions {
-            at: Location::input(name),
-            message: "a ROS bag is read twice (topics, then messages): give a regular file, \
-                      not a pipe or device"
-                .into(),
-        });
+    read_rosbag_parts(file, name, None, topic)
+}
+
+/// [`read_rosbag_file`] of a bag whose first storage file is `first` (opened, named
+/// `name`) and, for a ROS 2 bag folder, the rest of `folder.storage` after it.
+pub fn read_rosbag_parts(
+    first: std::fs::File,
+    name: &str,
+    folder: Option<&Ros2BagFolder>,
+    topic: Option<&str>,
+) -> Result<ImuLog, LogError> {
+    let rest: Vec<String> = folder
+        .map(|f| {
+            f.storage
+                .iter()
+                .skip(1)
+                .map(|p| p.display().to_string())
+                .collect()
+        })
+        .unwrap_or_default();
+    let message_zstd = folder.is_some_and(|f| f.message_zstd);
+    let mut first = Some(first);
+    let mut parts = Vec::with_capacity(1 + rest.len());
+    for part_name in std::iter::once(name).chain(rest.iter().map(String::as_str)) {
+        let file = match first.take() {
+            Some(f) => f,
+            None => std::fs::File::open(part_name).map_err(|error| LogError::Io {
+                path: part_name.to_owned(),
+                error,
+            })?,
+        };
+        parts.push(Part::open(file, part_name)?);
     }
-    let size = meta.len();
-    file.seek(SeekFrom::Start(0)).map_err(io)?;
-    let mut head = [0u8; 16];
-    let n = (&mut file).take(16).read(&mut head).map_err(io)?;
-    let format = detect_format(&head[..n]).ok_or_else(|| LogError::InvalidOptions {
-        at: Location::input(name),
-        message: "not a ROS 1 bag (#ROSBAG V2.0) or MCAP file (no magic bytes)".into(),
-    })?;
-    let scan = |file: &mut std::fs::File,
-                visit: &mut dyn FnMut(Item<'_>) -> Result<(), LogError>|
-     -> Result<(), LogError> {
-        file.seek(SeekFrom::Start(0)).map_err(io)?;
-        let mut src = Source::new(&mut *file, name, size);
-        match format {
-            BagFormat::Ros1 => ros1::scan(&mut src, visit),
-            BagFormat::Mcap => mcap::scan(&mut src, visit),
-            BagFormat::Sqlite3 => Err(LogError::InvalidOptions {
-                at: Location::input(name),
-                message: "a ROS 2 sqlite3 bag (.db3) is not read here; convert it to MCAP, \
-                          e.g. `rosbags-convert --src BAG --dst OUT --dst-storage mcap` (Python \
-                          rosbags) or `ros2 bag convert`"
-                    .into(),
-            }),
-        }
-    };
     // Pass 1: the topics.
     let mut topics = Topics::default();
-    scan(&mut file, &mut |item| {
-        match item {
-            Item::Connection {
-                id,
-                topic,
-                msg_type,
-            } => topics.add(id, topic, msg_type),
-            Item::Message { conn, .. } => topics.count(conn),
-        }
-        Ok(())
-    })?;
+    for (p, part) in parts.iter_mut().enumerate() {
+        part.scan(true, &mut |item| {
+            match item {
+                Item::Connection {
+                    id,
+                    topic,
+                    msg_type,
+                } => topics.add((p, id), topic, msg_type),
+                Item::Message { conn, .. } => topics.count((p, conn), 1),
+                Item::Count { conn, messages } => topics.count((p, conn), messages),
+            }
+            Ok(())
+        })?;
+    }
     let imu_topic = topics.choose_imu(topic, name)?;
     let temp_topic = topics.only_of(Kind::Temperature);
     // Pass 2: the messages of the chosen topics.
-    let encoding = match format {
-        BagFormat::Ros1 => Encoding::Ros1,
-        _ => Encoding::Cdr,
-    };
     let mut imu = ImuColumns::default();
     let mut temp: Vec<(f64, f64)> = Vec::new();
-    scan(&mut file, &mut |item| {
-        let Item::Message {
-            conn,
-            byte_offset,
-            data,
-        } = item
-        else {
-            return Ok(());
+    let mut plain = Vec::new();
+    for (p, part) in parts.iter_mut().enumerate() {
+        let (part_name, format) = (part.name, part.format);
+        let encoding = match format {
+            BagFormat::Ros1 => Encoding::Ros1,
+            _ => Encoding::Cdr,
         };
-        let Some(t) = topics.topic_of(conn) else {
-            return Ok(());
-        };
-        let bad = |message: String| LogError::AtByte {
-            path: name.to_owned(),
-            byte_offset,
-            format: format.name(),
-            message,
-        };
-        if t == imu_topic {
-            let s = cdr::decode_imu(data, encoding).map_err(|m| {
-                bad(format!(
-                    "{} message {} on {}: {m}",
-                    encoding.type_name(Kind::Imu),
-                    imu.len(),
-                    topics.name(t)
-                ))
-            })?;
-            imu.push(s, byte_offset).map_err(bad)?;
-        } else if Some(t) == temp_topic {
-            let (stamp, celsius) = cdr::decode_temperature(data, encoding).map_err(|m| {
-                bad(format!(
-                    "{} message {} on {}: {m}",
-                    encoding.type_name(Kind::Temperature),
-                    temp.len(),
-                    topics.name(t)
-                ))
-            })?;
-            if !celsius.is_finite() {
-                return Err(bad(format!(
-                    "non-finite temperature {celsius} on {}",
-                    topics.name(t)
-                )));
+        part.scan(false, &mut |item| {
+            let Item::Message {
+                conn,
+                byte_offset,
+                data,
+            } = item
+            else {
+                return Ok(());
+            };
+            let Some(t) = topics.topic_of((p, conn)) else {
+                return Ok(());
+            };
+            if t != imu_topic && Some(t) != temp_topic {
+                return Ok(());
             }
-            temp.push((stamp, celsius));
+            let bad = |message: String| LogError::AtByte {
+                path: part_name.to_owned(),
+                byte_offset,
+                format: format.name(),
+                message,
+            };
+            let data = if message_zstd {
+                compress::decompress(compress::Codec::Zstd, data, None, &mut plain)
+                    .map_err(|m| bad(format!("message on {}: {m}", topics.name(t))))?;
+                &plain[..]
+            } else {
+                data
+            };
+            if t == imu_topic {
+                let s = cdr::decode_imu(data, encoding).map_err(|m| {
+                    bad(format!(
+                        "{} message {} on {}: {m}",
+                        encoding.type_name(Kind::Imu),
+                        imu.len(),
+                        topics.name(t)
+                    ))
+                })?;
+                imu.push(s, byte_offset).map_err(bad)?;
+            } else {
+                let (stamp, celsius) = cdr::decode_temperature(data, encoding).map_err(|m| {
+                    bad(format!(
+                        "{} message {} on {}: {m}",
+                        encoding.type_name(Kind::Temperature),
+                        temp.len(),
+                        topics.name(t)
+                    ))
+                })?;
+                if !celsius.is_finite() {
+                    return Err(bad(format!(
+                        "non-finite temperature {celsius} on {}",
+                        topics.name(t)
+                    )));
+                }
+                temp.push((stamp, celsius));
+            }
+            Ok(())
+        })?;
+    }
+    let format = parts.first().map_or("ROS bag", |p| p.format.name());
+    imu.into_log(name, format, temp)
+}
+
+/// One storage file of a bag, opened, its format known.
+struct Part<'n> {
+    file: std::fs::File,
+    name: &'n str,
+    size: u64,
+    format: BagFormat,
+}
+
+impl<'n> Part<'n> {
+    fn open(mut file: std::fs::File, name: &'n str) -> Result<Self, LogError> {
+        let io = |error| LogError::Io {
+            path: name.to_owned(),
+            error,
+        };
+        let meta = file.metadata().map_err(io)?;
+        if !meta.is_file() {
+            return Err(LogError::InvalidOptions {
+                at: Location::input(name),
+                message: "a ROS bag is read twice (topics, then messages): give a regular \
+                          file, not a pipe or device"
+                    .into(),
+            });
         }
-        Ok(())
-    })?;
-    imu.into_log(name, format.name(), temp)
+        file.seek(SeekFrom::Start(0)).map_err(io)?;
+        let mut head = [0u8; 16];
+        let n = (&mut file).take(16).read(&mut head).map_err(io)?;
+        let format = detect_format(&head[..n]).ok_or_else(|| LogError::InvalidOptions {
+            at: Location::input(name),
+            message: "not a ROS 1 bag (#ROSBAG V2.0), MCAP file or ROS 2 sqlite3 bag (no magic \
+                      bytes)"
+                .into(),
+        })?;
+        Ok(Part {
+            file,
+            name,
+            size: meta.len(),
+            format,
+        })
+    }
+
+    /// Reads the file from its start, handing on connections and messages in stored order
+    /// (`topics_only`: messages may be handed on as counts instead).
+    fn scan(
+        &mut self,
+        topics_only: bool,
+        visit: &mut dyn FnMut(Item<'_>) -> Result<(), LogError>,
+    ) -> Result<(), LogError> {
+        if self.format == BagFormat::Sqlite3 {
+            return db3::scan(&mut self.file, self.name, self.size, visit);
+        }
+        self.file
+            .seek(SeekFrom::Start(0))
+            .map_err(|error| LogError::Io {
+                path: self.name.to_owned(),
+                error,
+            })?;
+        let mut src = Source::new(&mut self.file, self.name, self.size);
+        match self.format {
+            BagFormat::Ros1 => ros1::scan(&mut src, topics_only, visit),
+            _ => mcap::scan(&mut src, visit),
+        }
+    }
 }
 
 /// What a format scanner hands on, in file order.
@@ -257,6 +311,9 @@ pub(crate) enum Item<'a> {
         topic: &'a str,
         msg_type: &'a str,
     },
+    /// How many messages a connection has in one chunk, from a ROS 1 index (when the
+    /// messages themselves are not read: [`Part::scan`]'s `topics_only`).
+    Count { conn: u32, messages: u64 },
     /// One message: its connection, the byte offset of its record (for errors; within a
     /// chunk, the chunk's offset) and its serialized bytes.
     Message {
@@ -302,17 +359,20 @@ fn kind_of(msg_type: &str) -> Kind {
     }
 }
 
+/// A connection: (index of its storage file, its id in that file).
+type ConnKey = (usize, u32);
+
 /// The bag's topics (several connections may share one topic).
 #[derive(Default)]
 struct Topics {
     /// (topic, type, kind, messages).
-    list: Vec<(String, String, Kind, usize)>,
-    /// (connection id, index into `list`).
-    conns: Vec<(u32, usize)>,
+    list: Vec<(String, String, Kind, u64)>,
+    /// ((storage file, connection id), index into `list`).
+    conns: Vec<(ConnKey, usize)>,
 }
 
 impl Topics {
-    fn add(&mut self, id: u32, topic: &str, msg_type: &str) {
+    fn add(&mut self, id: ConnKey, topic: &str, msg_type: &str) {
         if self.conns.iter().any(|&(c, _)| c == id) {
             return;
         }
@@ -330,15 +390,15 @@ impl Topics {
         };
         self.conns.push((id, i));
     }
-    fn topic_of(&self, conn: u32) -> Option<usize> {
+    fn topic_of(&self, conn: ConnKey) -> Option<usize> {
         self.conns
             .iter()
             .find(|&&(c, _)| c == conn)
             .map(|&(_, i)| i)
     }
-    fn count(&mut self, conn: u32) {
+    fn count(&mut self, conn: ConnKey, messages: u64) {
         if let Some(i) = self.topic_of(conn) {
-            self.list[i].3 += 1;
+            self.list[i].3 += messages;
         }
     }
     fn name(&self, i: usize) -> &str {

@@ -4,6 +4,7 @@
 //! inside chunks (op 0x05); the index section at the end repeats the connections. All
 //! integers little-endian.
 
+use super::compress::{self, Codec};
 use super::{Item, Source, le_u32};
 use crate::io::error::LogError;
 
@@ -59,16 +60,18 @@ fn op_of(header: &[u8]) -> Result<u8, String> {
 }
 
 /// Hands on the connections and messages of records `data` (a chunk's content) that starts
-/// at file offset `base`.
+/// at file offset `base`; for a decompressed chunk (`compressed`), `base` is the chunk
+/// record's offset and every record inside is reported there.
 fn records_in_chunk(
     src: &Source<'_>,
     data: &[u8],
     base: u64,
+    compressed: bool,
     visit: &mut dyn FnMut(Item<'_>) -> Result<(), LogError>,
 ) -> Result<(), LogError> {
     let mut at = 0usize;
     while at < data.len() {
-        let record_at = base + at as u64;
+        let record_at = if compressed { base } else { base + at as u64 };
         let err = |m: String| src.error(FORMAT, record_at, m);
         let truncated = || err("record runs past the end of its chunk".into());
         let hlen = le_u32(data, at).ok_or_else(truncated)? as usize;
@@ -134,8 +137,14 @@ fn record(
 }
 
 /// Reads the bag front to back, handing on connections and messages in file order.
+///
+/// With `topics_only`, a bag whose header points to an index section (`index_pos` ≠ 0: the
+/// recording was closed) is read without opening its chunks: the index section repeats
+/// every connection record, and each chunk-info record counts the chunk's messages per
+/// connection ([`Item::Count`]), so a compressed bag is decompressed once, not twice.
 pub(crate) fn scan(
     src: &mut Source<'_>,
+    topics_only: bool,
     visit: &mut dyn FnMut(Item<'_>) -> Result<(), LogError>,
 ) -> Result<(), LogError> {
     let mut buf = Vec::new();
@@ -159,6 +168,8 @@ pub(crate) fn scan(
     }
     let mut header = Vec::new();
     let mut body = Vec::new();
+    let mut plain = Vec::new();
+    let mut indexed = false;
     while src.remaining() > 0 {
         let record_at = src.pos;
         src.read_into(FORMAT, record_at, 4, "a record's header length", &mut buf)?;
@@ -174,22 +185,47 @@ pub(crate) fn scan(
         let dlen = le_u32(&buf, 0).unwrap_or(0);
         let op = op_of(&header).map_err(|m| src.error(FORMAT, record_at, m))?;
         match op {
-            OP_CHUNK => {
-                let compression = str_field(&header, "compression")
-                    .map_err(|m| src.error(FORMAT, record_at, m))?;
-                if compression != "none" {
-                    return Err(src.error(
-                        FORMAT,
-                        record_at,
-                        format!(
-                            "{compression}-compressed chunk: compressed ROS 1 bags are not read; \
-                             decompress it first (`rosbag decompress BAG`)"
-                        ),
-                    ));
+            OP_CHUNK if topics_only && indexed => {
+                src.skip(FORMAT, record_at, dlen.into(), "a chunk")?;
+            }
+            OP_CHUNK_INFO if topics_only && indexed => {
+                src.read_into(FORMAT, record_at, dlen.into(), "a record's data", &mut body)?;
+                let err = |m: String| src.error(FORMAT, record_at, format!("chunk info: {m}"));
+                let n = u32_field(&header, "count").map_err(err)?;
+                for k in 0..n as usize {
+                    let pair = body
+                        .get(8 * k..8 * k + 8)
+                        .ok_or_else(|| err(format!("{n} connections, data of {dlen} bytes")))?;
+                    visit(Item::Count {
+                        conn: le_u32(pair, 0).unwrap_or(0),
+                        messages: le_u32(pair, 4).unwrap_or(0).into(),
+                    })?;
                 }
+            }
+            OP_BAG_HEADER => {
+                if let Ok(Some(pos)) = field(&header, b"index_pos") {
+                    indexed = pos.len() == 8 && pos.iter().any(|&b| b != 0);
+                }
+                src.skip(FORMAT, record_at, dlen.into(), "a record's data")?;
+            }
+            OP_CHUNK => {
+                let chunk_err = |src: &Source<'_>, m: String| {
+                    src.error(FORMAT, record_at, format!("chunk: {m}"))
+                };
+                let codec = str_field(&header, "compression")
+                    .and_then(|c| Codec::of(c, &[Codec::Bz2, Codec::Lz4]))
+                    .map_err(|m| chunk_err(src, m))?;
                 let data_at = src.pos;
                 src.read_into(FORMAT, record_at, dlen.into(), "a chunk", &mut body)?;
-                records_in_chunk(src, &body, data_at, visit)?;
+                match codec {
+                    None => records_in_chunk(src, &body, data_at, false, visit)?,
+                    Some(codec) => {
+                        let size = u32_field(&header, "size").map_err(|m| chunk_err(src, m))?;
+                        compress::decompress(codec, &body, Some(size.into()), &mut plain)
+                            .map_err(|m| chunk_err(src, m))?;
+                        records_in_chunk(src, &plain, record_at, true, visit)?;
+                    }
+                }
             }
             OP_CONNECTION | OP_MESSAGE => {
                 src.read_into(FORMAT, record_at, dlen.into(), "a record's data", &mut body)?;
@@ -198,7 +234,7 @@ pub(crate) fn scan(
                     Failure::Error(e) => *e,
                 })?;
             }
-            OP_INDEX | OP_CHUNK_INFO | OP_BAG_HEADER => {
+            OP_INDEX | OP_CHUNK_INFO => {
                 src.skip(FORMAT, record_at, dlen.into(), "a record's data")?;
             }
             op => {
