@@ -55,6 +55,13 @@ def main():
         "workers_2": {"seconds": round(s2, 2), "units_per_s": round(a.units / s2, 3)},
         "speedup": round(s1 / s2, 3),
         "loadavg_1min_before_after": [round(load_before[0], 2), round(load_after[0], 2)],
+        # thermal fit error per channel over the fleet: max |Δb_fit − Δb_true| over the set
+        # temperatures as a fraction of the true swing (largest and median unit)
+        "fit_error_of_swing": {
+            ch: {"max": round(max(e), 4), "median": round(sorted(e)[len(e) // 2], 4)}
+            for ch in fleet.CHANNELS
+            for e in [[r[f"{ch}_err_max"] / r[f"{ch}_swing"] for r in rows1]]
+        },
     }
     if a.json:
         print(json.dumps(out, indent=2))
@@ -65,6 +72,9 @@ def main():
         print(f"{w} worker(s): {a.units} units in {r['seconds']:.2f} s = {r['units_per_s']:.2f} units/s")
     print(f"speed-up 2 vs 1 worker: {out['speedup']:.2f}x "
           f"(load average before/after: {out['loadavg_1min_before_after']})")
+    for ch, e in out["fit_error_of_swing"].items():
+        print(f"{ch}: thermal fit error {100 * e['max']:.2f} % of the swing at worst, "
+              f"{100 * e['median']:.2f} % median")
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ it, from the median step of ``time_s``.
 
 import json
 import math
+import numbers
 import os
 from collections.abc import Mapping
 
@@ -121,7 +122,8 @@ def _log(data, gyro, accel, temperature_c, time_s, rate_hz, name, need_temperatu
         i = int(np.flatnonzero(np.diff(t) <= 0)[0])
         raise ValueError(f"time_s must increase: sample {i + 1} ({t[i + 1]}) is not after {t[i]}")
     if rate_hz is not None:
-        if not (isinstance(rate_hz, (int, float)) and math.isfinite(rate_hz) and rate_hz > 0):
+        if not (isinstance(rate_hz, numbers.Real) and not isinstance(rate_hz, bool)
+                and math.isfinite(rate_hz) and rate_hz > 0):
             raise ValueError(f"rate_hz must be a positive number of samples per second, got {rate_hz!r}")
         tau0 = 1.0 / float(rate_hz)
     elif t is not None:
@@ -440,22 +442,22 @@ def thermal_fit(data=None, *, manifest=None, manifest_toml=None, method=None, gy
         method = "ramp" if manifest is None and manifest_toml is None else "soak"
     if method not in ("soak", "ramp"):
         raise ValueError(f'method must be "soak" or "ramp", got {method!r}')
-    if not (isinstance(order, int) and 1 <= order <= 5):
+    if not (isinstance(order, numbers.Integral) and not isinstance(order, bool) and 1 <= order <= 5):
         raise ValueError(f"order must be an integer 1–5, got {order!r}")
-    if not (isinstance(t_ref_c, (int, float)) and math.isfinite(t_ref_c)):
+    if not (isinstance(t_ref_c, numbers.Real) and math.isfinite(t_ref_c)):
         raise ValueError(f"t_ref_c must be a finite temperature in °C, got {t_ref_c!r}")
     log = _log(data, gyro, accel, temperature_c, time_s, rate_hz, name,
                need_temperature=(method == "ramp"))
     if method == "soak":
         text, mname = _manifest(manifest, manifest_toml)
-        raw = _driftless.thermal_soak(log.args(), text, mname, order, float(t_ref_c),
+        raw = _driftless.thermal_soak(log.args(), text, mname, int(order), float(t_ref_c),
                                       str(out_of_range), float(min_rise_c))
     else:
         if manifest is not None or manifest_toml is not None:
             raise ValueError("the ramp method takes no manifest (it bins the logged temperature)")
         if log.path is None and log.time_s is None:
             raise ValueError("the ramp method needs time_s")
-        raw = _driftless.thermal_ramp(log.args(), order, float(t_ref_c), float(bin_c),
+        raw = _driftless.thermal_ramp(log.args(), int(order), float(t_ref_c), float(bin_c),
                                       float(min_rise_c))
     return ThermalModel(raw["model_toml"], raw["model_json"], method=raw["method"],
                         fits=list(raw["fits"]), temperatures_c=raw.get("temperatures_c"),

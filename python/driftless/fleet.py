@@ -36,7 +36,7 @@ CHANNELS = ("gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z")
 #: temperatures −20 … 70 °C, short dwells (one unit is about 0.3 s of CPU); the sensor
 #: settles in each soak (lag 5 s against 60 s: e^−12 of the step left).
 DEFAULT_PROTOCOL = {
-    "rate_hz": 100.0,
+    "rate_hz": 200.0,
     "temperatures_c": [-20.0, -5.0, 10.0, 25.0, 40.0, 55.0, 70.0],
     "soak_s": 60.0,
     "position_dwell_s": 30.0,

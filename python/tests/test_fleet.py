@@ -10,10 +10,12 @@ from driftless import fleet
 
 UNITS = 4
 SEED = 7
+# the default protocol at a quarter of its rate: the same code, a quarter of the work
+PROTOCOL = dict(fleet.DEFAULT_PROTOCOL, rate_hz=50.0)
 
 
 def test_units_are_deterministic_and_distinct():
-    a, b = fleet.simulate_unit(1, SEED), fleet.simulate_unit(1, SEED)
+    a, b = fleet.simulate_unit(1, SEED, PROTOCOL), fleet.simulate_unit(1, SEED, PROTOCOL)
     for k in a["imu"]:
         np.testing.assert_array_equal(a["imu"][k], b["imu"][k])
     assert a["manifest_toml"] == b["manifest_toml"]
@@ -27,11 +29,12 @@ def test_units_are_deterministic_and_distinct():
 
 def test_dask_table_equals_the_serial_table():
     distributed = pytest.importorskip("distributed")
-    serial = [fleet.unit_row(u, SEED) for u in range(UNITS)]
+    serial = [fleet.unit_row(u, SEED, PROTOCOL) for u in range(UNITS)]
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster:
         with distributed.Client(cluster) as client:
-            futures = client.map(fleet.unit_row, range(UNITS), [SEED] * UNITS, pure=True)
+            futures = client.map(fleet.unit_row, range(UNITS), [SEED] * UNITS,
+                                 [PROTOCOL] * UNITS, pure=True)
             table = client.gather(futures)
             workers = {w for w in client.run(lambda: 1)}
     assert len(workers) == 2

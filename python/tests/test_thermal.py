@@ -118,9 +118,9 @@ def test_ramp_on_arrays_gives_a_bias_model():
 
 
 def test_fleet_unit_fit_recovers_its_truth():
-    """One noisy fleet unit (adi-like noise at 100 Hz, 30-s dwells): the fitted bias
-    change over the soak range is within 6 % of the true swing on every channel — over
-    40 units of seed 0 the worst channel was 5.3 % and the median 0.6–1.7 %, the bias
+    """One noisy fleet unit (adi-like noise at 200 Hz, 30-s dwells): the fitted bias
+    change over the soak range is within 8 % of the true swing on every channel — over
+    60 units of seed 0 the worst channel was 7.1 % and the medians 0.7–1.7 %: the bias
     instability and rate random walk between the steps (a wrong or missing term would
     be tens of %)."""
     unit = fleet.simulate_unit(3, seed=11)
@@ -128,6 +128,6 @@ def test_fleet_unit_fit_recovers_its_truth():
     assert row["unit_id"] == 3
     for ch in fleet.CHANNELS:
         assert row[f"{ch}_swing"] > 0
-        assert row[f"{ch}_err_max"] < 0.06 * row[f"{ch}_swing"], (ch, row[f"{ch}_err_max"],
+        assert row[f"{ch}_err_max"] < 0.08 * row[f"{ch}_swing"], (ch, row[f"{ch}_err_max"],
                                                                    row[f"{ch}_swing"])
         assert row[f"{ch}_true_c1"] == unit["truth"][ch][1]
