@@ -24,6 +24,9 @@ __version__ = _driftless.__version__
 __all__ = [
     "adev", "oadev", "mdev", "hdev", "ohdev", "tdev", "totdev",
     "analyse", "AnalysisResult", "NoiseModel", "simulate", "Simulation",
+    "calibrate_six_position", "calibrate_multi_position", "CalibrationResult",
+    "thermal_fit", "thermal_compensate", "ThermalModel", "simulate_chamber", "ChamberSession",
+    "sensor_preset", "fleet",
 ]
 
 
@@ -259,3 +262,10 @@ def simulate(scenario_toml, name="<scenario>"):
     relative paths in it resolve against the working directory). ``name`` appears in
     error messages."""
     return Simulation(_driftless.simulate_scenario(str(scenario_toml), str(name)))
+
+
+from ._calib import (  # noqa: E402  (after the module's own API)
+    CalibrationResult, ChamberSession, ThermalModel, calibrate_multi_position,
+    calibrate_six_position, sensor_preset, simulate_chamber, thermal_compensate, thermal_fit,
+)
+from . import fleet  # noqa: E402

@@ -1,4 +1,4 @@
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -67,3 +67,151 @@ class Simulation:
     def to_dict(self) -> Dict[str, Any]: ...
 
 def simulate(scenario_toml: str, name: str = "<scenario>") -> Simulation: ...
+
+# Calibration and thermal calibration (driftless._calib)
+
+import os
+
+from . import fleet as fleet
+
+_Path = Union[str, bytes, "os.PathLike[str]"]
+_Columns = Mapping[str, npt.ArrayLike]
+_Array = npt.NDArray[np.float64]
+
+class CalibrationResult:
+    method: str
+    source: str
+    gravity_m_s2: float
+    accel_raw_unit: str
+    accel_bias: _Array
+    accel_bias_sigma: _Array
+    accel_matrix: _Array
+    accel_matrix_sigma: _Array
+    accel_forward: _Array
+    accel_scale_factor: _Array
+    accel_misalignment: _Array
+    accel_residual_rms: Optional[float]
+    gyro_raw_unit: str
+    gyro_bias: _Array
+    gyro_bias_sigma: _Array
+    gyro_matrix: _Array
+    gyro_matrix_sigma: _Array
+    gyro_forward: _Array
+    gyro_scale_factor: _Array
+    gyro_misalignment: _Array
+    gyro_residual_rms: Optional[float]
+    gyro_g_sensitivity: Optional[_Array]
+    static_intervals: _Array
+    quality: Optional[Dict[str, Dict[str, Any]]]
+    residuals_m_s2: Optional[_Array]
+    details: Dict[str, Any]
+    def apply(
+        self, accel: Optional[npt.ArrayLike] = None, gyro: Optional[npt.ArrayLike] = None
+    ) -> Tuple[Optional[_Array], Optional[_Array]]: ...
+    def to_dict(self) -> Dict[str, Any]: ...
+    def to_toml(self) -> str: ...
+    def save(self, path: _Path) -> None: ...
+    @classmethod
+    def load(cls, path: _Path) -> "CalibrationResult": ...
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "CalibrationResult": ...
+
+def calibrate_six_position(
+    data: Union[None, _Path, _Columns] = None,
+    *,
+    manifest: Optional[_Path] = None,
+    manifest_toml: Optional[str] = None,
+    gyro: Optional[npt.ArrayLike] = None,
+    accel: Optional[npt.ArrayLike] = None,
+    time_s: Optional[npt.ArrayLike] = None,
+    rate_hz: Optional[float] = None,
+    temperature_c: Optional[float] = None,
+    gravity_m_s2: Optional[float] = None,
+    g_sensitivity: bool = False,
+    units: str = "si",
+    name: Optional[str] = None,
+) -> CalibrationResult: ...
+def calibrate_multi_position(
+    data: Union[None, _Path, _Columns] = None,
+    *,
+    gyro: Optional[npt.ArrayLike] = None,
+    accel: Optional[npt.ArrayLike] = None,
+    time_s: Optional[npt.ArrayLike] = None,
+    rate_hz: Optional[float] = None,
+    gravity_m_s2: Optional[float] = None,
+    lat_deg: float = 45.0,
+    height_m: float = 0.0,
+    gyro_scale_guess: Optional[float] = None,
+    accel_offset: Optional[float] = None,
+    accept_poor_fit: bool = False,
+    units: str = "si",
+    name: Optional[str] = None,
+) -> CalibrationResult: ...
+
+class ThermalModel:
+    model_id: int
+    t_ref_c: float
+    range_c: Tuple[float, float]
+    out_of_range: str
+    accel_raw_unit: str
+    accel_bias: _Array
+    accel_matrix: _Array
+    accel_bias_delta: _Array
+    accel_scale_delta: _Array
+    gyro_raw_unit: str
+    gyro_bias: _Array
+    gyro_matrix: _Array
+    gyro_bias_delta: _Array
+    gyro_scale_delta: _Array
+    gyro_g_sensitivity: Optional[_Array]
+    method: Optional[str]
+    fits: List[Dict[str, Any]]
+    temperatures_c: Optional[_Array]
+    warnings: List[str]
+    def fit(self, triad: str, quantity: str, axis: str) -> Dict[str, Any]: ...
+    def compensate(
+        self, gyro: npt.ArrayLike, accel: npt.ArrayLike, temperature_c: npt.ArrayLike
+    ) -> Tuple[_Array, _Array]: ...
+    def to_dict(self) -> Dict[str, Any]: ...
+    def to_toml(self) -> str: ...
+    def save(self, path: _Path) -> None: ...
+    @classmethod
+    def load(cls, path: _Path) -> "ThermalModel": ...
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "ThermalModel": ...
+
+def thermal_fit(
+    data: Union[None, _Path, _Columns] = None,
+    *,
+    manifest: Optional[_Path] = None,
+    manifest_toml: Optional[str] = None,
+    method: Optional[str] = None,
+    gyro: Optional[npt.ArrayLike] = None,
+    accel: Optional[npt.ArrayLike] = None,
+    temperature_c: Optional[npt.ArrayLike] = None,
+    time_s: Optional[npt.ArrayLike] = None,
+    rate_hz: Optional[float] = None,
+    order: int = 3,
+    t_ref_c: float = 25.0,
+    out_of_range: str = "clamp",
+    min_rise_c: float = 10.0,
+    bin_c: float = 1.0,
+    name: Optional[str] = None,
+) -> ThermalModel: ...
+def thermal_compensate(
+    model: Union[ThermalModel, _Path],
+    gyro: npt.ArrayLike,
+    accel: npt.ArrayLike,
+    temperature_c: npt.ArrayLike,
+) -> Tuple[_Array, _Array]: ...
+
+class ChamberSession:
+    tau0_s: float
+    imu: Dict[str, _Array]
+    manifest_toml: str
+    sensor: Dict[str, Any]
+
+def simulate_chamber(
+    scenario_toml: str, name: str = "<scenario>", sensor: Optional[Mapping[str, Any]] = None
+) -> ChamberSession: ...
+def sensor_preset(name: str) -> Dict[str, Any]: ...

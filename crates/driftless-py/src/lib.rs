@@ -5,7 +5,9 @@
 //! allantools' tau selection, result classes) is the pure-Python `driftless` package.
 
 mod analysis;
+mod calib;
 mod compat;
+mod thermal;
 
 use driftless::allan::fit::FitConfig;
 use driftless::allan::{DataType, DevPoint, Estimator};
@@ -159,14 +161,7 @@ fn simulate_scenario<'py>(
     let log = sim.rates_log(name);
     let d = PyDict::new(py);
     d.set_item("tau0_s", log.tau0_s)?;
-    let imu = PyDict::new(py);
-    if let Some(t) = &log.time_s {
-        imu.set_item("time_s", t.clone().into_pyarray(py))?;
-    }
-    for c in &log.channels {
-        imu.set_item(&c.name, c.values.clone().into_pyarray(py))?;
-    }
-    d.set_item("imu", imu)?;
+    d.set_item("imu", calib::log_columns(py, &log)?)?;
     if let Some(g) = &sim.gnss {
         let gnss = PyDict::new(py);
         gnss.set_item("time_s", g.time_s.clone().into_pyarray(py))?;
@@ -187,6 +182,19 @@ fn _driftless(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(allan_compat, m)?)?;
     m.add_function(wrap_pyfunction!(analyse_channel, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_scenario, m)?)?;
+    m.add_function(wrap_pyfunction!(calib::calib_six_position, m)?)?;
+    m.add_function(wrap_pyfunction!(calib::calib_multi_position, m)?)?;
+    m.add_function(wrap_pyfunction!(calib::calib_load, m)?)?;
+    m.add_function(wrap_pyfunction!(calib::calib_save, m)?)?;
+    m.add_function(wrap_pyfunction!(calib::calib_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::thermal_soak, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::thermal_ramp, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::thermal_load, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::thermal_save, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::thermal_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::thermal_compensate, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::sensor_preset_json, m)?)?;
+    m.add_function(wrap_pyfunction!(thermal::chamber_simulate, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

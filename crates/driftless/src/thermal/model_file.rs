@@ -241,15 +241,54 @@ impl ThermalModelFile {
         Ok((f, m))
     }
 
+    /// The file's text (what [`Self::save`] writes); `name` leads an error.
+    pub fn to_toml_string(&self, name: &str) -> Result<String, ThermalModelError> {
+        toml::to_string(self).map_err(|e| ThermalModelError::Invalid {
+            path: name.to_owned(),
+            message: e.to_string(),
+        })
+    }
+
     /// Writes the file.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), ThermalModelError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let text = toml::to_string(self).map_err(|e| ThermalModelError::Invalid {
-            path: name.clone(),
-            message: e.to_string(),
-        })?;
+        let text = self.to_toml_string(&name)?;
         crate::io::output::write(path, text)
             .map_err(|source| ThermalModelError::Io { path: name, source })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_round_trips_and_names_the_file_on_error() {
+        let section = |unit: &str, b: f64| TriadSection {
+            raw_unit: unit.into(),
+            bias: [b, -b, 0.5 * b],
+            matrix: [[1.0, 1e-3, 0.0], [0.0, 1.0, -2e-3], [0.0, 0.0, 1.0]],
+            bias_delta: std::array::from_fn(|k| vec![0.0, 1e-3 * (k as f64 + 1.0), -2e-6, 3e-8]),
+            scale_delta: std::array::from_fn(|_| vec![0.0, 2e-5]),
+        };
+        let f = ThermalModelFile {
+            format_version: FORMAT_VERSION,
+            model_id: 12345,
+            t_ref_c: 25.0,
+            range_c: [-20.0, 60.0],
+            out_of_range: "clamp".into(),
+            gyro_g_sensitivity: None,
+            accel: section("m/s^2", 0.1),
+            gyro: section("rad/s", 2e-3),
+        };
+        let text = f.to_toml_string("m.toml").unwrap();
+        let (back, model) = ThermalModelFile::from_toml_str(&text, "m.toml").unwrap();
+        assert_eq!(back, f);
+        assert_eq!(model.id(), 12345);
+        let e = ThermalModelFile::from_toml_str(&text.replace("clamp", "hold"), "m.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("m.toml: ") && e.contains("hold"), "{e}");
     }
 }
