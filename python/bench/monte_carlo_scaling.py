@@ -1,12 +1,15 @@
 """Monte Carlo throughput on a Dask LocalCluster of 1 and of 2 worker processes.
 
-The same N runs of a scenario (default: the built-in adi-like experiment, 16 runs: run 0, the detailed
-run, costs about twice the others, so fewer runs leave one worker idle at the end) are
-computed with ``driftless.montecarlo.run_one`` on K = 1 and K = 2 workers (one thread
-and one library thread each). Before timing, every worker builds the scenario's shared
-stages once (the noise stage) by running one warm-up task; the timed part is the N
-runs, submission to the last result. Prints runs/s per K, the speed-up of K = 2 over
-K = 1, and the machine's load (``os.getloadavg``) before and after.
+The same N runs of a scenario (default: the built-in adi-like experiment, 16 runs; run
+0, the detailed run, costs about twice the others, so fewer runs leave one worker idle
+at the end) are computed with ``driftless.montecarlo.run_one`` on K = 1 and K = 2
+workers (one thread and one library thread each). Before timing, every worker builds
+the scenario's shared stages once (the noise stage) by running one warm-up task; the
+timed part is the N runs, submission to the last result. Prints runs/s per K, the
+speed-up of K = 2 over K = 1, the workers' CPU seconds per run (user + system, summed
+over the workers) with the cores they kept busy, and the machine's load
+(``os.getloadavg``) before and after: on a shared machine the speed-up is bounded by
+the cores other processes leave free.
 
     python python/bench/monte_carlo_scaling.py [SCENARIO] [--runs N]
 """
