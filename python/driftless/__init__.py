@@ -27,6 +27,8 @@ __all__ = [
     "calibrate_six_position", "calibrate_multi_position", "CalibrationResult",
     "thermal_fit", "thermal_compensate", "ThermalModel", "simulate_chamber", "ChamberSession",
     "sensor_preset", "fleet",
+    "navigate", "NavResult", "Solution", "default_nav_config",
+    "experiment", "ExperimentResult", "montecarlo",
 ]
 
 
@@ -236,21 +238,28 @@ class Simulation:
     """The output of a scenario: ``imu`` maps ``time_s`` and each channel (``gyro_x`` …
     rad/s, ``acc_x`` … m/s^2, as ``driftless simulate`` names them) to NumPy arrays;
     ``gnss`` maps ``time_s``, ``lat_rad``, ``lon_rad``, ``height_m`` to arrays (None
-    without a receiver); ``sensor`` is the resolved sensor configuration;
-    ``tau0_s`` the IMU sample interval."""
+    without a receiver, plus ``sigma_n_m``, ``sigma_e_m``, ``sigma_d_m`` and, when
+    simulated, the velocity ``vel_n_m_s`` … with its σ); ``sensor`` is the resolved
+    sensor configuration; ``tau0_s`` the IMU sample interval; ``truth`` the true
+    trajectory of the IMU centre (``time_s``, ``lat_rad``, ``lon_rad``, ``height_m``,
+    ``vel_n_m_s`` …, ``roll_rad`` …); ``lever_arm_b_m`` the GNSS antenna from the IMU,
+    body FRD, m."""
 
     def __init__(self, raw):
         self.tau0_s = raw["tau0_s"]
         self.imu = raw["imu"]
         self.gnss = raw.get("gnss")
         self.sensor = json.loads(raw["sensor_json"])
+        self.truth = raw["truth"]
+        self.lever_arm_b_m = list(raw["lever_arm_b_m"])
 
     def to_dict(self):
         """Plain Python lists and dicts (JSON-serialisable)."""
         def plain(columns):
             return None if columns is None else {k: v.tolist() for k, v in columns.items()}
         return {"tau0_s": self.tau0_s, "imu": plain(self.imu), "gnss": plain(self.gnss),
-                "sensor": json.loads(json.dumps(self.sensor))}
+                "sensor": json.loads(json.dumps(self.sensor)), "truth": plain(self.truth),
+                "lever_arm_b_m": list(self.lever_arm_b_m)}
 
     def __repr__(self):
         n = len(next(iter(self.imu.values()))) if self.imu else 0
@@ -269,3 +278,6 @@ from ._calib import (  # noqa: E402  (after the module's own API)
     calibrate_six_position, sensor_preset, simulate_chamber, thermal_compensate, thermal_fit,
 )
 from . import fleet  # noqa: E402
+from ._nav import NavResult, Solution, default_nav_config, navigate  # noqa: E402
+from . import montecarlo  # noqa: E402
+from .montecarlo import ExperimentResult, experiment  # noqa: E402

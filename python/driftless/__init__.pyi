@@ -1,4 +1,5 @@
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+import os
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -64,13 +65,13 @@ class Simulation:
     imu: Dict[str, npt.NDArray[np.float64]]
     gnss: Optional[Dict[str, npt.NDArray[np.float64]]]
     sensor: Dict[str, Any]
+    truth: Dict[str, npt.NDArray[np.float64]]
+    lever_arm_b_m: List[float]
     def to_dict(self) -> Dict[str, Any]: ...
 
 def simulate(scenario_toml: str, name: str = "<scenario>") -> Simulation: ...
 
 # Calibration and thermal calibration (driftless._calib)
-
-import os
 
 from . import fleet as fleet
 
@@ -215,3 +216,61 @@ def simulate_chamber(
     scenario_toml: str, name: str = "<scenario>", sensor: Optional[Mapping[str, Any]] = None
 ) -> ChamberSession: ...
 def sensor_preset(name: str) -> Dict[str, Any]: ...
+
+# Navigation and the experiment (driftless._nav, driftless.montecarlo)
+
+class Solution:
+    time_s: npt.NDArray[np.float64]
+    lat_rad: npt.NDArray[np.float64]
+    lon_rad: npt.NDArray[np.float64]
+    height_m: npt.NDArray[np.float64]
+    vel_n_m_s: npt.NDArray[np.float64]
+    vel_e_m_s: npt.NDArray[np.float64]
+    vel_d_m_s: npt.NDArray[np.float64]
+    roll_rad: npt.NDArray[np.float64]
+    pitch_rad: npt.NDArray[np.float64]
+    yaw_rad: npt.NDArray[np.float64]
+    sigma_n_m: npt.NDArray[np.float64]
+    sigma_e_m: npt.NDArray[np.float64]
+    sigma_d_m: npt.NDArray[np.float64]
+    def __getattr__(self, name: str) -> npt.NDArray[np.float64]: ...
+    def columns(self) -> Dict[str, npt.NDArray[np.float64]]: ...
+    def to_dict(self) -> Dict[str, List[float]]: ...
+    def horizontal_rms_m(
+        self, reference: Union[_Columns, "Solution"], *, from_s: Optional[float] = None,
+        max_reference_gap_s: float = 2.0,
+    ) -> float: ...
+    def __len__(self) -> int: ...
+
+class NavResult:
+    forward: Solution
+    smoothed: Optional[Solution]
+    gnss_accepted: int
+    gnss_rejected: int
+    gnss_withheld: int
+    gnss_fixes: int
+    start_time_s: float
+    prediction_rms_m: Optional[float]
+    outages: List[Dict[str, Optional[float]]]
+    config: Optional[Dict[str, Any]]
+    notes: List[str]
+    files: List[str]
+    def horizontal_rms_m(
+        self, reference: Union[_Columns, Solution], *, smoothed: bool = False,
+        from_s: Optional[float] = None, max_reference_gap_s: float = 2.0,
+    ) -> float: ...
+    def to_dict(self) -> Dict[str, Any]: ...
+
+def default_nav_config() -> Dict[str, Dict[str, Any]]: ...
+def navigate(
+    imu: Union[None, _Columns, _Path] = None,
+    gnss: Union[None, _Columns, _Path] = None,
+    config: Union[None, Mapping[str, Mapping[str, Any]], _Path] = None,
+    *,
+    smooth: bool = True,
+    outages: Optional[str] = None,
+    gate: Optional[str] = None,
+) -> NavResult: ...
+
+from . import montecarlo as montecarlo
+from .montecarlo import ExperimentResult as ExperimentResult, experiment as experiment

@@ -7,6 +7,8 @@
 mod analysis;
 mod calib;
 mod compat;
+mod experiment;
+mod nav;
 mod thermal;
 
 use driftless::allan::fit::FitConfig;
@@ -168,12 +170,25 @@ fn simulate_scenario<'py>(
         gnss.set_item("lat_rad", g.lat_rad.clone().into_pyarray(py))?;
         gnss.set_item("lon_rad", g.lon_rad.clone().into_pyarray(py))?;
         gnss.set_item("height_m", g.height_m.clone().into_pyarray(py))?;
+        let axis = |v: &[[f64; 3]], k: usize| v.iter().map(|x| x[k]).collect::<Vec<f64>>();
+        for (k, n) in ["n", "e", "d"].iter().enumerate() {
+            gnss.set_item(
+                format!("sigma_{n}_m"),
+                axis(&g.sigma_ned_m, k).into_pyarray(py),
+            )?;
+            if let (Some(v), Some(sv)) = (&g.vel_ned_m_s, &g.sigma_vel_ned_m_s) {
+                gnss.set_item(format!("vel_{n}_m_s"), axis(v, k).into_pyarray(py))?;
+                gnss.set_item(format!("sigma_vel_{n}_m_s"), axis(sv, k).into_pyarray(py))?;
+            }
+        }
         d.set_item("gnss", gnss)?;
     }
     d.set_item(
         "sensor_json",
         serde_json::to_string(&sim.sensor).map_err(value_error)?,
     )?;
+    d.set_item("truth", nav::trajectory_columns(py, &sim.truth)?)?;
+    d.set_item("lever_arm_b_m", sim.lever_arm_b_m.to_vec())?;
     Ok(d)
 }
 
@@ -196,5 +211,18 @@ fn _driftless(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(thermal::sensor_preset_json, m)?)?;
     m.add_function(wrap_pyfunction!(thermal::chamber_simulate, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_function(wrap_pyfunction!(nav::nav_default_config, m)?)?;
+    m.add_function(wrap_pyfunction!(nav::navigate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(nav::navigate_files, m)?)?;
+    m.add_function(wrap_pyfunction!(nav::navigate_kf_gins, m)?)?;
+    m.add_function(wrap_pyfunction!(nav::horizontal_rms, m)?)?;
+    m.add_function(wrap_pyfunction!(
+        experiment::experiment_builtin_scenario,
+        m
+    )?)?;
+    m.add_function(wrap_pyfunction!(experiment::experiment_run, m)?)?;
+    m.add_function(wrap_pyfunction!(experiment::montecarlo_prepare, m)?)?;
+    m.add_function(wrap_pyfunction!(experiment::montecarlo_run_one, m)?)?;
+    m.add_function(wrap_pyfunction!(experiment::montecarlo_summarise, m)?)?;
     Ok(())
 }

@@ -12,6 +12,8 @@
 //!   checked on a cheap reference before any long computation);
 //! * [`monte_carlo`]: repetitions with new seeds, per-case statistics and the ratios
 //!   (b)/(c), (d)/(c) with bootstrap intervals;
+//! * [`per_run`]: the same Monte Carlo one run at a time (runs spread over processes or
+//!   machines) and its statistics from the runs' records;
 //! * [`budget`]: each outage's linearised error budget and the reversals it explains;
 //! * [`table`]: the paper's Table 1 as Markdown and CSV.
 //!
@@ -21,6 +23,7 @@
 
 pub mod budget;
 pub mod monte_carlo;
+pub mod per_run;
 pub mod report;
 pub mod run;
 pub mod scenario;

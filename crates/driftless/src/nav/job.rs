@@ -246,6 +246,11 @@ pub struct NavInputs {
 
 /// Runs the job of `cfg`: [`read_nav_inputs`], the outages, [`run_session`].
 pub fn run_nav_job(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavJobResult, NavJobError> {
+    run_inputs(read_nav_inputs(cfg, csv)?)
+}
+
+/// The outages and the session on checked inputs.
+fn run_inputs(inputs: NavInputs) -> Result<NavJobResult, NavJobError> {
     let NavInputs {
         imu,
         imu_format,
@@ -255,7 +260,7 @@ pub fn run_nav_job(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavJobResult
         outages,
         notes,
         imu_check,
-    } = read_nav_inputs(cfg, csv)?;
+    } = inputs;
     let (spec, selection) = choose_outages(outages, &fixes)?;
     session_config.outages = select_gnss(&fixes, &imu, &spec, GnssOutsideImu::Drop)?.windows;
     let session = run_session(&imu, &fixes, &session_config)?;
@@ -270,6 +275,40 @@ pub fn run_nav_job(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavJobResult
         notes,
         imu_check,
     })
+}
+
+/// Runs the job of `cfg` on data in memory: `log` a log of rates (three angular-rate and
+/// three specific-force channels, time stamps in `imu.time_base`, as a rates CSV gives
+/// them) and `gnss` the fixes; `imu.file`, `gnss.file` and the reader settings of `cfg`
+/// are not used (the result names the format [`ImuFormat::Csv`], rates). Everything else
+/// is [`run_nav_job`]'s: the same stream options, IMU
+/// checks, calibration, quality filter, outages and session, so a log and fixes read from
+/// files give the same result as [`run_nav_job`] on those files.
+pub fn run_nav_job_in_memory(
+    cfg: &LoadedConfig,
+    log: &crate::data::ImuLog,
+    gnss: GnssFixes,
+) -> Result<NavJobResult, NavJobError> {
+    let settings = job_settings(cfg)?;
+    let imu = imu_from_rates_log(log, &RateChannels::ByQuantity, &cfg.config.stream_options())?;
+    let gnss_name = "GNSS fixes in memory";
+    gnss.validate().map_err(|e| {
+        NavJobError::Config(ConfigError {
+            location: gnss_name.into(),
+            message: e.to_string(),
+        })
+    })?;
+    let source = log.source.clone();
+    let inputs = finish_inputs(
+        cfg,
+        settings,
+        imu,
+        ImuFormat::Csv,
+        &source,
+        || Ok(gnss),
+        gnss_name,
+    )?;
+    run_inputs(inputs)
 }
 
 /// Reads the files of `cfg` and builds the settings. `csv` says how to read a rates CSV
@@ -298,8 +337,74 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
         ));
     }
     let format = detect_imu_format(&c.imu.format, &imu_path, tag.is_some());
-    let mut notes = Vec::new();
-    // Everything that needs no data file is checked before the data are read.
+    let settings = job_settings(cfg)?;
+    let opts = c.stream_options();
+    let imu = match format {
+        ImuFormat::Kfgins => {
+            let inc = crate::io::nav::read_kfgins_imu_file(&imu_path)?;
+            imu_from_kfgins(&inc, &imu_path.display().to_string(), &opts)?
+        }
+        ImuFormat::TaggedCsv => {
+            let tag = tag.unwrap_or_else(|| default_tag(&imu_path));
+            if PathKind::of(&tag) != PathKind::File {
+                return Err(located(
+                    cfg,
+                    "imu.tag",
+                    format!(
+                        "{}: no such tag file; a tagged CSV needs its RTKLIB .tag (pass --tag)",
+                        tag.display()
+                    ),
+                ));
+            }
+            imu_from_tagged_csv_files(
+                &imu_path,
+                &tag,
+                &TaggedCsvOptions {
+                    stream: opts,
+                    ..TaggedCsvOptions::default()
+                },
+            )?
+        }
+        ImuFormat::Csv => {
+            let mut text = csv.clone();
+            text.drop_truncated_edges = true;
+            if let Some(w) = &c.imu.week_column {
+                text.week_column =
+                    Some(w.parse().map_err(|e: crate::io::text::ParseSpecError| {
+                        located(cfg, "imu.week_column", e.to_string())
+                    })?);
+            }
+            let log = crate::io::read_log_file(&imu_path, &text)?;
+            imu_from_rates_log(&log, &RateChannels::ByQuantity, &opts)?
+        }
+    };
+    let name = imu_path.display().to_string();
+    finish_inputs(
+        cfg,
+        settings,
+        imu,
+        format,
+        &name,
+        || Ok(read_gnss_file(&gnss_path, &GnssReadOptions::default())?),
+        &gnss_path.display().to_string(),
+    )
+}
+
+/// What a job needs besides the data: the noise settings (with the noise model file, if
+/// any), the outage specification and the calibration (with its file, if any).
+struct JobSettings {
+    noise: ImuNoise,
+    sigma0: [f64; 12],
+    spec: OutageSpec,
+    calibration: Option<(
+        driftless_model::calib::ImuCalibration,
+        Option<driftless_model::linalg::Mat3>,
+    )>,
+}
+
+/// The settings of `cfg` that need no data file, checked (before any data are read).
+fn job_settings(cfg: &LoadedConfig) -> Result<JobSettings, NavJobError> {
+    let c = &cfg.config;
     let model = match &c.noise.model {
         Some(p) => Some(crate::allan::noise_model::NoiseModel::load(
             &cfg.path("noise.model", p),
@@ -341,53 +446,41 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
         }
         None => None,
     };
+    Ok(JobSettings {
+        noise,
+        sigma0,
+        spec,
+        calibration,
+    })
+}
+
+/// The rest of a job's inputs once the IMU stream is built: its notes, the IMU value
+/// checks (and repairs), the calibration, the GNSS fixes from `read_gnss` (called after
+/// the IMU checks) inside the IMU span that pass the quality filter, the session settings.
+/// `imu_name` and `gnss_name` name the sources in notes and messages.
+fn finish_inputs(
+    cfg: &LoadedConfig,
+    settings: JobSettings,
+    mut imu: ImuStream,
+    format: ImuFormat,
+    imu_name: &str,
+    read_gnss: impl FnOnce() -> Result<GnssFixes, NavJobError>,
+    gnss_name: &str,
+) -> Result<NavInputs, NavJobError> {
+    let c = &cfg.config;
+    let JobSettings {
+        noise,
+        sigma0,
+        spec,
+        calibration,
+    } = settings;
     let opts = c.stream_options();
-    let mut imu = match format {
-        ImuFormat::Kfgins => {
-            let inc = crate::io::nav::read_kfgins_imu_file(&imu_path)?;
-            imu_from_kfgins(&inc, &imu_path.display().to_string(), &opts)?
-        }
-        ImuFormat::TaggedCsv => {
-            let tag = tag.unwrap_or_else(|| default_tag(&imu_path));
-            if PathKind::of(&tag) != PathKind::File {
-                return Err(located(
-                    cfg,
-                    "imu.tag",
-                    format!(
-                        "{}: no such tag file; a tagged CSV needs its RTKLIB .tag (pass --tag)",
-                        tag.display()
-                    ),
-                ));
-            }
-            imu_from_tagged_csv_files(
-                &imu_path,
-                &tag,
-                &TaggedCsvOptions {
-                    stream: opts,
-                    ..TaggedCsvOptions::default()
-                },
-            )?
-        }
-        ImuFormat::Csv => {
-            let mut text = csv.clone();
-            text.drop_truncated_edges = true;
-            if let Some(w) = &c.imu.week_column {
-                text.week_column =
-                    Some(w.parse().map_err(|e: crate::io::text::ParseSpecError| {
-                        located(cfg, "imu.week_column", e.to_string())
-                    })?);
-            }
-            let log = crate::io::read_log_file(&imu_path, &text)?;
-            imu_from_rates_log(&log, &RateChannels::ByQuantity, &opts)?
-        }
-    };
+    let mut notes = Vec::new();
     notes.extend(imu.notes.iter().cloned());
     for g in imu.gaps.iter().take(20) {
         notes.push(format!(
-            "{}: IMU gap of {:.4} s before t = {:.4} s: integrated across",
-            imu_path.display(),
-            g.gap_s,
-            g.time_s
+            "{imu_name}: IMU gap of {:.4} s before t = {:.4} s: integrated across",
+            g.gap_s, g.time_s
         ));
     }
     if imu.gaps.len() > 20 {
@@ -426,7 +519,7 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
     if let Some((cal, g)) = &calibration {
         imu.apply_calibration(cal, g.as_ref());
     }
-    let gnss = read_gnss_file(&gnss_path, &GnssReadOptions::default())?;
+    let gnss = read_gnss()?;
     notes.extend(gnss.notes.iter().cloned());
     let all = select_gnss(&gnss, &imu, &OutageSpec::None, GnssOutsideImu::Drop)?;
     let accepted = c.accepted_qualities();
@@ -447,9 +540,7 @@ pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInput
             cfg,
             "gnss.accept",
             format!(
-                "{}: no GNSS fix inside the IMU span passes the quality filter ({} dropped)",
-                gnss_path.display(),
-                dropped
+                "{gnss_name}: no GNSS fix inside the IMU span passes the quality filter ({dropped} dropped)"
             ),
         ));
     }

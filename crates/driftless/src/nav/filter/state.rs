@@ -19,17 +19,17 @@ pub const N_STATES: usize = 21;
 /// First index of the position error.
 pub const POS: usize = 0;
 /// First index of the velocity error.
-pub(crate) const VEL: usize = 3;
+pub const VEL: usize = 3;
 /// First index of the attitude error.
-pub(crate) const ATT: usize = 6;
+pub const ATT: usize = 6;
 /// First index of the gyro bias.
-pub(crate) const BG: usize = 9;
+pub const BG: usize = 9;
 /// First index of the accelerometer bias.
-pub(crate) const BA: usize = 12;
+pub const BA: usize = 12;
 /// First index of the gyro scale factor.
-pub(crate) const SG: usize = 15;
+pub const SG: usize = 15;
 /// First index of the accelerometer scale factor.
-pub(crate) const SA: usize = 18;
+pub const SA: usize = 18;
 
 /// A full 21 × 21 covariance (row-major, symmetric).
 pub type Cov = [[f64; N_STATES]; N_STATES];

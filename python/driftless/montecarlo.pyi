@@ -1,0 +1,43 @@
+import os
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+_Row = Dict[str, Union[int, float, str, bool]]
+_Scenario = Union[str, "os.PathLike[str]", "Plan"]
+
+def builtin_scenario() -> str: ...
+
+class Plan:
+    text: str
+    name: str
+    base_dir: str
+    runs: int
+    seed: int
+    outages: List[Tuple[float, float]]
+    def run_one(self, run_index: int) -> _Row: ...
+    def summarise(self, rows: Iterable[Mapping[str, Any]]) -> "Summary": ...
+
+def prepare(scenario: _Scenario) -> Plan: ...
+def run_one(scenario: _Scenario, run_index: int) -> _Row: ...
+
+class Summary:
+    runs: int
+    cases: List[Dict[str, Any]]
+    ratio_room_over_thermal: Optional[Dict[str, float]]
+    ratio_full_room_over_thermal: Optional[Dict[str, float]]
+    def to_dict(self) -> Dict[str, Any]: ...
+    def columns(self) -> Dict[str, Any]: ...
+    def table(self) -> str: ...
+
+def summarise(rows: Iterable[Mapping[str, Any]], scenario: _Scenario) -> Summary: ...
+def rows_to_columns(rows: Iterable[Mapping[str, Any]]) -> Dict[str, Any]: ...
+
+class ExperimentResult:
+    rows: List[_Row]
+    summary: Summary
+    def columns(self) -> Dict[str, Any]: ...
+    def to_dict(self) -> Dict[str, Any]: ...
+
+def experiment(scenario: Union[str, "os.PathLike[str]"], *, runs: Optional[int] = None) -> ExperimentResult: ...
