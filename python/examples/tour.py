@@ -55,17 +55,79 @@ print(f"gyro white noise: simulated {white_true:.3e}, fitted {white_fit:.3e} rad
       f"({100 * (white_fit / white_true - 1):+.1f} %)")
 
 # %% [markdown]
-# ## Calibration and thermal compensation
-# Place for the calibration and thermal cells: six-position and multi-position
-# calibration of a simulated chamber log (`driftless.calibrate_six_position`,
-# `driftless.calibrate_multi_position`), a thermal fit (`driftless.thermal_fit`) and
-# `ThermalModel.compensate` applied to the drive's IMU columns before navigating.
+# ## 3. Six-position and thermal calibration in a simulated chamber
+# A short chamber session of the same ADIS16465-class sensor with its deterministic
+# errors switched on: at each of five set temperatures the unit soaks, rests in six
+# positions and turns on a rate table (20 Hz, 30-s soaks, so it runs in seconds).
+# `simulate_chamber` returns the IMU columns and the segment manifest the protocol
+# wrote — what a chamber's own log and protocol file would give.
 
 # %%
-# (calibration / thermal cells go here)
+chamber = driftless.simulate_chamber("""seed = 7
+[imu]
+rate_hz = 20.0
+preset = "adi-like"
+output = "rates"
+[trajectory]
+type = "chamber"
+temperatures_c = [-20.0, 0.0, 25.0, 50.0, 70.0]
+soak_s = 30.0
+position_dwell_s = 10.0
+move_s = 2.0
+rate_deg_s = 60.0
+rate_revolutions = 1
+spin_s = 1.0
+lag_tau_s = 1.0
+""", name="tour chamber")
+print(chamber)
 
 # %% [markdown]
-# ## 3. Navigate with full GNSS
+# Six-position calibration at 25 °C: bias, scale factor and misalignment of both
+# triads, each with its standard error. The simulated accelerometer bias at 25 °C is the
+# constant term of the sensor's bias polynomial plus a turn-on bias the simulator draws
+# at power-up (σ 0.049 m/s² here) — the part no datasheet gives and calibration measures.
+
+# %%
+cal = driftless.calibrate_six_position(chamber.imu, manifest_toml=chamber.manifest_toml,
+                                       temperature_c=25.0)
+print(cal)
+datasheet = np.array([p[0] for p in chamber.sensor["accel"]["bias_poly_m_s2"]])
+print("accel bias (m/s²): estimated", np.round(cal.accel_bias, 4),
+      "±", np.round(cal.accel_bias_sigma, 4), "; polynomial's constant term",
+      np.round(datasheet, 4))
+print("scale factor (1 + s):", np.round(cal.accel_scale_factor, 5), "; simulated",
+      np.round([1 + p[0] for p in chamber.sensor["accel"]["scale_factor_poly"]], 5))
+
+# %% [markdown]
+# The soak method repeats that calibration at every set temperature and fits a cubic
+# in ΔT = T − 25 °C per bias and scale factor. `ThermalModel.compensate` applies it to
+# raw samples — the kernel the `no_std` crate runs on a device. Calibrating the
+# compensated log again at each temperature shows what is left: the model holds the
+# 25 °C calibration and the thermal cubics, so the bias is near zero at every set
+# temperature (the gyro's ±25 °/h is the noise of this short protocol's 10-s dwells).
+
+# %%
+thermal = driftless.thermal_fit(chamber.imu, manifest_toml=chamber.manifest_toml)
+print(thermal)
+f = thermal.fit("gyro", "bias", "x")
+print("gyro x bias cubic c0…c3:", ", ".join(f"{c:.3e}" for c in f["coefficients"]))
+gyro = np.column_stack([chamber.imu[f"gyro_{a}"] for a in "xyz"])
+accel = np.column_stack([chamber.imu[f"acc_{a}"] for a in "xyz"])
+gyro_c, accel_c = thermal.compensate(gyro, accel, chamber.imu["temp"])
+compensated = dict(chamber.imu)
+for k, a in enumerate("xyz"):
+    compensated[f"gyro_{a}"], compensated[f"acc_{a}"] = gyro_c[:, k], accel_c[:, k]
+print("set °C   gyro x bias [°/h] raw → compensated   accel x bias [m/s²] raw → compensated")
+for t in (-20.0, 0.0, 25.0, 50.0, 70.0):
+    raw = driftless.calibrate_six_position(chamber.imu, manifest_toml=chamber.manifest_toml,
+                                           temperature_c=t)
+    comp = driftless.calibrate_six_position(compensated, manifest_toml=chamber.manifest_toml,
+                                            temperature_c=t)
+    print(f"{t:6.0f}   {np.degrees(raw.gyro_bias[0]) * 3600:10.1f} → {np.degrees(comp.gyro_bias[0]) * 3600:8.1f}"
+          f"          {raw.accel_bias[0]:10.4f} → {comp.accel_bias[0]:8.4f}")
+
+# %% [markdown]
+# ## 4. Navigate with full GNSS
 # The loosely coupled filter and the RTS smoother. The configuration is the one
 # `driftless nav --config` reads, as a dict of sections (`driftless.default_nav_config()`
 # lists every key); here only the lever arm. The horizontal RMS error against the truth
@@ -83,7 +145,7 @@ print(f"full GNSS: horizontal RMS vs truth forward {full.horizontal_rms_m(sim.tr
 print("solution columns:", ", ".join(list(full.forward.columns())[:12]), "…")
 
 # %% [markdown]
-# ## 4. Navigate through a 30-s GNSS outage
+# ## 5. Navigate through a 30-s GNSS outage
 # `outages.spec = "100+30"` withholds the fixes from 100 s after the first fix for 30 s
 # (the `driftless nav --outages` grammar). The forward filter dead-reckons through it;
 # the smoother bridges it from both ends.
@@ -111,7 +173,7 @@ print(f"  smoothed: largest {smo_err.max():.2f} m")
 print(f"  after the outage: forward error at the first fix {o['end_horizontal_m']:.2f} m")
 
 # %% [markdown]
-# ## 5. The experiment, and its Monte Carlo one run at a time
+# ## 6. The experiment, and its Monte Carlo one run at a time
 # `driftless.experiment` runs `driftless experiment` on a scenario (here the small one:
 # seconds of work). `driftless.montecarlo.run_one(plan, i)` computes run i alone — the
 # building block for spreading runs over processes or machines

@@ -14,5 +14,6 @@ def test_tour_runs():
     assert done.returncode == 0, done.stderr[-3000:]
     out = done.stdout
     for expected in ("full GNSS: horizontal RMS vs truth", "outage ", "smoothed: largest",
-                     "gyro white noise: simulated", "run 2 alone"):
+                     "gyro white noise: simulated", "run 2 alone",
+                     "accel bias (m/s²): estimated", "raw → compensated"):
         assert expected in out, (expected, out[-2000:])

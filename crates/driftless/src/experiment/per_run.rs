@@ -13,10 +13,11 @@
 use super::ExperimentError;
 use super::monte_carlo::{MonteCarloSummary, summarise};
 use super::run::{
-    Case, CaseRun, NoiseStage, Prepared, ThermalStage, VehicleRun, noise_stage, splitmix64,
-    thermal_stage, vehicle_run,
+    Case, CaseRun, NoiseStage, Prepared, ThermalStage, VehicleRun, noise_stage, thermal_stage,
+    vehicle_run,
 };
 use crate::eval::metrics::{OutageErrors, OutageReport, OutageSummary, Stat};
+use crate::numeric::splitmix::splitmix64_mix;
 
 /// What every run of an experiment shares (module docs).
 #[derive(Debug)]
@@ -241,7 +242,7 @@ pub fn summarise_records(
     Ok(summarise(
         &runs,
         p.scenario.monte_carlo.confidence,
-        splitmix64(p.scenario.seed ^ 0xB007),
+        splitmix64_mix(p.scenario.seed ^ 0xB007),
     ))
 }
 
