@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ConvertArgs {
-    /// Input log (text, binary DRIFTLOG, PX4 ULog or ArduPilot DataFlash).
+    /// Input log (text, binary DRIFTLOG, PX4 ULog, ArduPilot DataFlash, ROS bag or MCAP file).
     pub input: PathBuf,
     /// Output: `.dlog` (binary DRIFTLOG) or `.csv` / `.txt` (delimited text); another
     /// name (a device, a pipe) needs `--to`.
