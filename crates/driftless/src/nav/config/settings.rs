@@ -99,25 +99,7 @@ impl NavConfig {
         model: Option<&crate::allan::noise_model::NoiseModel>,
     ) -> Result<(ImuNoise, [f64; 12]), KeyError> {
         let n = &self.noise;
-        let q = |key: &str, v: &Option<String>, kind: Kind| -> Result<Option<f64>, KeyError> {
-            v.as_deref()
-                .map(|s| parse_quantity(s, kind).map_err(|e| key_err(key, e.to_string())))
-                .transpose()
-        };
-        positive("noise.bias_tau_s", n.bias_tau_s, 1e9, "s")?;
-        positive("noise.scale_tau_s", n.scale_tau_s, 1e9, "s")?;
-        for (k, v) in [
-            ("white", n.multiplier.white),
-            ("bias", n.multiplier.bias),
-            ("scale", n.multiplier.scale),
-        ] {
-            if !(v.is_finite() && v > 0.0 && v <= 1e4) {
-                return Err(key_err(
-                    "noise.multiplier",
-                    format!("{k} = {v}: a multiplier is > 0 (1 = as given)"),
-                ));
-            }
-        }
+        check_noise_ranges(n)?;
         let base = match model {
             Some(m) => {
                 let dummy = GaussMarkov {
@@ -130,148 +112,210 @@ impl NavConfig {
             None => crate::nav::session::consumer_mems_noise(),
         };
         let mut out = base;
-        if let Some(v) = q("noise.gyro_white", &n.gyro_white, Kind::AngleRandomWalk)? {
+        if let Some(v) = quantity("noise.gyro_white", &n.gyro_white, Kind::AngleRandomWalk)? {
             out.gyro_arw_rad_sqrt_s = v;
         }
-        if let Some(v) = q(
+        if let Some(v) = quantity(
             "noise.accel_white",
             &n.accel_white,
             Kind::VelocityRandomWalk,
         )? {
             out.accel_vrw_m_s_sqrt_s = v;
         }
-        let t = n.bias_tau_s;
-        let bias = |sigma_key: &str,
-                    sigma: &Option<String>,
-                    b_key: &str,
-                    b: &Option<String>,
-                    k_key: &str,
-                    k: &Option<String>,
-                    kinds: (Kind, Kind),
-                    base: GaussMarkov|
-         -> Result<GaussMarkov, KeyError> {
-            if let Some(s) = q(sigma_key, sigma, kinds.0)? {
-                return Ok(GaussMarkov { sigma: s, tau_s: t });
-            }
-            let bi = q(b_key, b, kinds.0)?;
-            let rw = q(k_key, k, kinds.1)?;
-            if bi.is_none() && rw.is_none() {
-                return Ok(GaussMarkov {
-                    sigma: base.sigma,
-                    tau_s: if model.is_some() { base.tau_s } else { t },
-                });
-            }
-            let (b, k) = (bi.unwrap_or(0.0), rw.unwrap_or(0.0));
-            Ok(GaussMarkov {
-                sigma: (b * b + k * k * t / 2.0).sqrt(),
-                tau_s: t,
-            })
-        };
-        out.gyro_bias = bias(
-            "noise.gyro_bias_sigma",
-            &n.gyro_bias_sigma,
-            "noise.gyro_bias_instability",
-            &n.gyro_bias_instability,
-            "noise.gyro_bias_random_walk",
-            &n.gyro_bias_random_walk,
+        let from_model = model.is_some();
+        out.gyro_bias = in_run_bias(
+            [
+                ("noise.gyro_bias_sigma", &n.gyro_bias_sigma),
+                ("noise.gyro_bias_instability", &n.gyro_bias_instability),
+                ("noise.gyro_bias_random_walk", &n.gyro_bias_random_walk),
+            ],
             (Kind::AngularRate, Kind::RateRandomWalk),
             base.gyro_bias,
+            n.bias_tau_s,
+            from_model,
         )?;
-        out.accel_bias = bias(
-            "noise.accel_bias_sigma",
-            &n.accel_bias_sigma,
-            "noise.accel_bias_instability",
-            &n.accel_bias_instability,
-            "noise.accel_bias_random_walk",
-            &n.accel_bias_random_walk,
+        out.accel_bias = in_run_bias(
+            [
+                ("noise.accel_bias_sigma", &n.accel_bias_sigma),
+                ("noise.accel_bias_instability", &n.accel_bias_instability),
+                ("noise.accel_bias_random_walk", &n.accel_bias_random_walk),
+            ],
             (Kind::SpecificForce, Kind::AccelRandomWalk),
             base.accel_bias,
+            n.bias_tau_s,
+            from_model,
         )?;
-        let req = |key: &str, v: &str, kind: Kind| {
-            parse_quantity(v, kind).map_err(|e| key_err(key, e.to_string()))
-        };
-        let sg = req("noise.gyro_scale_sigma", &n.gyro_scale_sigma, Kind::Scale)?;
-        let sa = req("noise.accel_scale_sigma", &n.accel_scale_sigma, Kind::Scale)?;
-        let m = n.multiplier;
-        out.gyro_arw_rad_sqrt_s *= m.white;
-        out.accel_vrw_m_s_sqrt_s *= m.white;
-        out.gyro_bias.sigma *= m.bias;
-        out.accel_bias.sigma *= m.bias;
-        out.gyro_scale = GaussMarkov {
-            sigma: sg * m.scale,
-            tau_s: n.scale_tau_s,
-        };
-        out.accel_scale = GaussMarkov {
-            sigma: sa * m.scale,
-            tau_s: n.scale_tau_s,
-        };
-        for (key, v, kind) in [
-            ("noise.gyro_scale_sigma", out.gyro_scale.sigma, "scale"),
-            ("noise.accel_scale_sigma", out.accel_scale.sigma, "scale"),
-            ("noise.gyro_bias_sigma", out.gyro_bias.sigma, "bias"),
-            ("noise.accel_bias_sigma", out.accel_bias.sigma, "bias"),
-        ] {
-            if v <= 0.0 {
-                return Err(key_err(
-                    key,
-                    format!(
-                        "the {kind} σ is zero: give a value > 0 (the filter needs some uncertainty)"
-                    ),
-                ));
-            }
-        }
-        if out.gyro_arw_rad_sqrt_s <= 0.0 || out.accel_vrw_m_s_sqrt_s <= 0.0 {
-            return Err(key_err("noise.gyro_white", "white noise must be > 0"));
-        }
-        let bg0 = req(
+        let sg = required_quantity("noise.gyro_scale_sigma", &n.gyro_scale_sigma, Kind::Scale)?;
+        let sa = required_quantity("noise.accel_scale_sigma", &n.accel_scale_sigma, Kind::Scale)?;
+        apply_multipliers(&mut out, n, sg, sa);
+        check_noise_nonzero(&out)?;
+        let bg0 = required_quantity(
             "noise.gyro_bias_initial",
             &n.gyro_bias_initial,
             Kind::AngularRate,
         )?;
-        let ba0 = req(
+        let ba0 = required_quantity(
             "noise.accel_bias_initial",
             &n.accel_bias_initial,
             Kind::SpecificForce,
         )?;
-        // Plausibility: the usual unit mix-ups show as absurd magnitudes.
-        let deg_s = |v: f64| v.to_degrees();
-        if out.gyro_arw_rad_sqrt_s > 0.01 {
-            return Err(key_err(
-                "noise.gyro_white",
-                format!(
-                    "{:.0} deg/sqrt(h) is implausible for a gyro: check the unit (deg/sqrt(h) vs deg/s/sqrt(Hz))",
-                    deg_s(out.gyro_arw_rad_sqrt_s) * 60.0
-                ),
-            ));
-        }
-        if bg0 > 0.2 || out.gyro_bias.sigma > 0.2 {
-            return Err(key_err(
-                "noise.gyro_bias_initial",
-                format!(
-                    "gyro bias σ {:.1} deg/s is implausible: check the unit (deg/h vs deg/s)",
-                    deg_s(bg0.max(out.gyro_bias.sigma))
-                ),
-            ));
-        }
-        if ba0 > 20.0 || out.accel_bias.sigma > 20.0 {
-            return Err(key_err(
-                "noise.accel_bias_initial",
-                "accelerometer bias σ above 2 g is implausible: check the unit (mg vs m/s^2)",
-            ));
-        }
-        let mut s0 = [0.0; 12];
-        for k in 0..3 {
-            s0[k] = bg0.max(out.gyro_bias.sigma);
-            s0[3 + k] = ba0.max(out.accel_bias.sigma);
-            s0[6 + k] = out.gyro_scale.sigma;
-            s0[9 + k] = out.accel_scale.sigma;
-        }
-        if s0.iter().any(|v| *v <= 0.0) {
-            return Err(key_err(
-                "noise.gyro_bias_initial",
-                "initial bias σ must be > 0",
-            ));
-        }
+        check_noise_plausible(&out, bg0, ba0)?;
+        let s0 = initial_sensor_sigma(&out, bg0, ba0)?;
         Ok((out, s0))
     }
+}
+
+/// An optional `[noise]` quantity parsed to the SI unit of `kind` (an error by `key`).
+fn quantity(key: &str, v: &Option<String>, kind: Kind) -> Result<Option<f64>, KeyError> {
+    v.as_deref()
+        .map(|s| parse_quantity(s, kind).map_err(|e| key_err(key, e.to_string())))
+        .transpose()
+}
+
+/// A required `[noise]` quantity parsed to the SI unit of `kind` (an error by `key`).
+fn required_quantity(key: &str, v: &str, kind: Kind) -> Result<f64, KeyError> {
+    parse_quantity(v, kind).map_err(|e| key_err(key, e.to_string()))
+}
+
+/// The correlation times (> 0, ≤ 10⁹ s) and the multipliers (> 0, ≤ 10⁴) of `[noise]`.
+fn check_noise_ranges(n: &NoiseSection) -> Result<(), KeyError> {
+    positive("noise.bias_tau_s", n.bias_tau_s, 1e9, "s")?;
+    positive("noise.scale_tau_s", n.scale_tau_s, 1e9, "s")?;
+    for (k, v) in [
+        ("white", n.multiplier.white),
+        ("bias", n.multiplier.bias),
+        ("scale", n.multiplier.scale),
+    ] {
+        if !(v.is_finite() && v > 0.0 && v <= 1e4) {
+            return Err(key_err(
+                "noise.multiplier",
+                format!("{k} = {v}: a multiplier is > 0 (1 = as given)"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// In-run bias of one sensor as a Gauss–Markov process with correlation time `tau_s`:
+/// the given σ (`keys[0]`); else σ² = B² + K²T/2 from the bias instability B (`keys[1]`)
+/// and random walk K (`keys[2]`); else `base` (its own time when `from_model`).
+fn in_run_bias(
+    keys: [(&str, &Option<String>); 3],
+    kinds: (Kind, Kind),
+    base: GaussMarkov,
+    tau_s: f64,
+    from_model: bool,
+) -> Result<GaussMarkov, KeyError> {
+    let t = tau_s;
+    let [(sigma_key, sigma), (b_key, b), (k_key, k)] = keys;
+    if let Some(s) = quantity(sigma_key, sigma, kinds.0)? {
+        return Ok(GaussMarkov { sigma: s, tau_s: t });
+    }
+    let bi = quantity(b_key, b, kinds.0)?;
+    let rw = quantity(k_key, k, kinds.1)?;
+    if bi.is_none() && rw.is_none() {
+        return Ok(GaussMarkov {
+            sigma: base.sigma,
+            tau_s: if from_model { base.tau_s } else { t },
+        });
+    }
+    let (b, k) = (bi.unwrap_or(0.0), rw.unwrap_or(0.0));
+    Ok(GaussMarkov {
+        sigma: (b * b + k * k * t / 2.0).sqrt(),
+        tau_s: t,
+    })
+}
+
+/// Scales the white densities, in-run bias σ and scale-factor σ (`sg`, `sa`) by the
+/// `[noise]` multipliers and sets the scale-factor processes (time `scale_tau_s`).
+fn apply_multipliers(out: &mut ImuNoise, n: &NoiseSection, sg: f64, sa: f64) {
+    let m = n.multiplier;
+    out.gyro_arw_rad_sqrt_s *= m.white;
+    out.accel_vrw_m_s_sqrt_s *= m.white;
+    out.gyro_bias.sigma *= m.bias;
+    out.accel_bias.sigma *= m.bias;
+    out.gyro_scale = GaussMarkov {
+        sigma: sg * m.scale,
+        tau_s: n.scale_tau_s,
+    };
+    out.accel_scale = GaussMarkov {
+        sigma: sa * m.scale,
+        tau_s: n.scale_tau_s,
+    };
+}
+
+/// Every scale-factor σ, in-run bias σ and white density of `out` > 0 (the filter needs
+/// some uncertainty).
+fn check_noise_nonzero(out: &ImuNoise) -> Result<(), KeyError> {
+    for (key, v, kind) in [
+        ("noise.gyro_scale_sigma", out.gyro_scale.sigma, "scale"),
+        ("noise.accel_scale_sigma", out.accel_scale.sigma, "scale"),
+        ("noise.gyro_bias_sigma", out.gyro_bias.sigma, "bias"),
+        ("noise.accel_bias_sigma", out.accel_bias.sigma, "bias"),
+    ] {
+        if v <= 0.0 {
+            return Err(key_err(
+                key,
+                format!(
+                    "the {kind} σ is zero: give a value > 0 (the filter needs some uncertainty)"
+                ),
+            ));
+        }
+    }
+    if out.gyro_arw_rad_sqrt_s <= 0.0 || out.accel_vrw_m_s_sqrt_s <= 0.0 {
+        return Err(key_err("noise.gyro_white", "white noise must be > 0"));
+    }
+    Ok(())
+}
+
+/// Plausible magnitudes (the usual unit mix-ups show as absurd ones): gyro white noise
+/// ≤ 0.01 rad/√s, gyro bias σ ≤ 0.2 rad/s, accelerometer bias σ ≤ 20 m/s²; `bg0`, `ba0`:
+/// the turn-on bias σ.
+fn check_noise_plausible(out: &ImuNoise, bg0: f64, ba0: f64) -> Result<(), KeyError> {
+    let deg_s = |v: f64| v.to_degrees();
+    if out.gyro_arw_rad_sqrt_s > 0.01 {
+        return Err(key_err(
+            "noise.gyro_white",
+            format!(
+                "{:.0} deg/sqrt(h) is implausible for a gyro: check the unit (deg/sqrt(h) vs deg/s/sqrt(Hz))",
+                deg_s(out.gyro_arw_rad_sqrt_s) * 60.0
+            ),
+        ));
+    }
+    if bg0 > 0.2 || out.gyro_bias.sigma > 0.2 {
+        return Err(key_err(
+            "noise.gyro_bias_initial",
+            format!(
+                "gyro bias σ {:.1} deg/s is implausible: check the unit (deg/h vs deg/s)",
+                deg_s(bg0.max(out.gyro_bias.sigma))
+            ),
+        ));
+    }
+    if ba0 > 20.0 || out.accel_bias.sigma > 20.0 {
+        return Err(key_err(
+            "noise.accel_bias_initial",
+            "accelerometer bias σ above 2 g is implausible: check the unit (mg vs m/s^2)",
+        ));
+    }
+    Ok(())
+}
+
+/// Initial σ of the 12 sensor states (gyro bias, accelerometer bias, gyro scale,
+/// accelerometer scale, three axes each): the larger of turn-on and in-run bias σ, the
+/// scale-factor σ; an error when one is not > 0.
+fn initial_sensor_sigma(out: &ImuNoise, bg0: f64, ba0: f64) -> Result<[f64; 12], KeyError> {
+    let mut s0 = [0.0; 12];
+    for k in 0..3 {
+        s0[k] = bg0.max(out.gyro_bias.sigma);
+        s0[3 + k] = ba0.max(out.accel_bias.sigma);
+        s0[6 + k] = out.gyro_scale.sigma;
+        s0[9 + k] = out.accel_scale.sigma;
+    }
+    if s0.iter().any(|v| *v <= 0.0) {
+        return Err(key_err(
+            "noise.gyro_bias_initial",
+            "initial bias σ must be > 0",
+        ));
+    }
+    Ok(s0)
 }

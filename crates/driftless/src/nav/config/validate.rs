@@ -5,6 +5,18 @@ use super::*;
 impl NavConfig {
     /// Checks every value: ranges, names, units. The first problem, by key.
     pub fn validate(&self) -> Result<(), KeyError> {
+        self.validate_imu()?;
+        self.validate_gnss()?;
+        self.noise_settings(None)?;
+        self.validate_align()?;
+        self.validate_aids()?;
+        self.gate()?;
+        self.validate_outages()
+    }
+
+    /// The `[imu]` values: reader format and tag, time offset and base, rate, mounting,
+    /// gap policy and hard limits.
+    fn validate_imu(&self) -> Result<(), KeyError> {
         let i = &self.imu;
         if !["auto", "kfgins", "tagged-csv", "csv"].contains(&i.format.as_str()) {
             return Err(key_err(
@@ -68,6 +80,11 @@ impl NavConfig {
                 return Err(key_err(k, format!("{v} {unit}: a limit is > 0")));
             }
         }
+        Ok(())
+    }
+
+    /// The `[gnss]` values: lever arm, σ floors and multipliers, accepted qualities.
+    fn validate_gnss(&self) -> Result<(), KeyError> {
         let g = &self.gnss;
         if !g
             .lever_arm_m
@@ -116,7 +133,11 @@ impl NavConfig {
                 ));
             }
         }
-        self.noise_settings(None)?;
+        Ok(())
+    }
+
+    /// The `[align]` values: speed, static time, course σ, baseline, given attitude.
+    fn validate_align(&self) -> Result<(), KeyError> {
         let a = &self.align;
         nonneg("align.min_speed_m_s", a.min_speed_m_s, 1000.0, "m/s")?;
         nonneg("align.static_s", a.static_s, 3600.0, "s")?;
@@ -145,6 +166,11 @@ impl NavConfig {
                 "give either initial_yaw_deg or initial_attitude_deg, not both",
             ));
         }
+        Ok(())
+    }
+
+    /// The `[aids]` values: ZUPT, ZARU, standstill detection and NHC.
+    fn validate_aids(&self) -> Result<(), KeyError> {
         let x = &self.aids;
         for (k, v, max, unit) in [
             ("aids.zupt_sigma_m_s", x.zupt_sigma_m_s, 10.0, "m/s"),
@@ -180,7 +206,11 @@ impl NavConfig {
             "m/s",
         )?;
         nonneg("aids.nhc_min_speed_m_s", x.nhc_min_speed_m_s, 1000.0, "m/s")?;
-        self.gate()?;
+        Ok(())
+    }
+
+    /// The `[outages]` values: the window specification and the convergence times.
+    fn validate_outages(&self) -> Result<(), KeyError> {
         let o = &self.outages;
         o.spec
             .parse::<crate::nav::outage::OutageSpec>()

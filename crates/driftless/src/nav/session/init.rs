@@ -50,36 +50,109 @@ pub(super) fn initialise_at(
     start_s: Option<f64>,
 ) -> Result<InitialState, NavError> {
     let fcfg = &cfg.filter;
-    let n = gnss.time_s.len();
-    let imu_start = imu
-        .epochs
-        .first()
-        .map(|e| e.time_s)
-        .unwrap_or(f64::INFINITY);
-    let imu_end = imu
-        .epochs
-        .last()
-        .map(|e| e.time_s)
-        .unwrap_or(f64::NEG_INFINITY);
-    let in_outage = |t: f64| cfg.outages.iter().any(|w| w.contains(t));
-    let quality_ok =
-        |i: usize| fcfg.accept_quality.is_empty() || fcfg.accept_quality.contains(&gnss.quality[i]);
-    // Usable for the chord: a fix the filter would use.
-    let fix_ok = |i: usize| !in_outage(gnss.time_s[i]) && quality_ok(i);
-    // Horizontal σ of fix i after the quality scaling, m.
-    let sigma_fix = |i: usize| {
-        let k = fcfg.quality_scale.factor(gnss.quality[i]);
-        let s = gnss.sigma_ned_m[i];
-        (s[0].max(s[1]) * k, s[2] * k)
+    let fixes = StartFixes::new(imu, gnss, cfg);
+    let given_yaw = given_yaw(cfg)?;
+    let (i, sv) = select_start(&fixes, cfg, given_yaw, start_s)?;
+    let t_start = gnss.time_s[i];
+    let (att, sigma_att_rad) =
+        initial_attitude(imu, gnss, cfg, primed_gyro_bias, given_yaw, &sv, t_start);
+    let q_bn = att.to_quat();
+    let (lat_rad, lon_rad, height_m) = imu_position(gnss, i, q_bn.rotate(fcfg.lever_arm_b_m));
+    let nav = NavState {
+        time_s: t_start,
+        lat_rad,
+        lon_rad,
+        height_m,
+        vel_ned_m_s: sv.v,
+        q_bn,
     };
-    let half = 0.5 * cfg.align_baseline_s;
-    let velocity = |i: usize| -> Option<StartVelocity> {
+    let (sensors, sigma_sensors) = initial_sensors(cfg, primed_gyro_bias);
+    let (sh, sv_pos) = fixes.sigma_fix(i);
+    // The chord is the mean velocity over the baseline: allow 0.3 m/s for the change of
+    // velocity over it (and GNSS velocity 0.1 m/s at least).
+    let floor_v = if gnss.vel_ned_m_s.is_some() { 0.1 } else { 0.3 };
+    Ok(InitialState {
+        nav,
+        sensors,
+        sigma_pos_ned_m: [sh.max(0.05), sh.max(0.05), sv_pos.max(0.1)],
+        sigma_vel_ned_m_s: [
+            sv.sigma_h_m_s.max(floor_v),
+            sv.sigma_h_m_s.max(floor_v),
+            sv.sigma_v_m_s.max(floor_v),
+        ],
+        sigma_att_rad,
+        sigma_sensors,
+    })
+}
+
+/// The GNSS fixes as candidates for the start: which are usable, their σ and velocity.
+struct StartFixes<'a> {
+    gnss: &'a GnssFixes,
+    cfg: &'a SessionConfig,
+    /// Time of the first IMU epoch, s (+∞ without epochs).
+    imu_start: f64,
+    /// Time of the last IMU epoch, s (−∞ without epochs).
+    imu_end: f64,
+}
+
+impl<'a> StartFixes<'a> {
+    /// The candidates among `gnss` for the IMU span of `imu`.
+    fn new(imu: &ImuStream, gnss: &'a GnssFixes, cfg: &'a SessionConfig) -> Self {
+        let imu_start = imu
+            .epochs
+            .first()
+            .map(|e| e.time_s)
+            .unwrap_or(f64::INFINITY);
+        let imu_end = imu
+            .epochs
+            .last()
+            .map(|e| e.time_s)
+            .unwrap_or(f64::NEG_INFINITY);
+        StartFixes {
+            gnss,
+            cfg,
+            imu_start,
+            imu_end,
+        }
+    }
+
+    /// Fix `i` usable for the chord: a fix the filter would use (outside the outage
+    /// windows, of an accepted quality).
+    fn fix_ok(&self, i: usize) -> bool {
+        let (gnss, cfg) = (self.gnss, self.cfg);
+        let fcfg = &cfg.filter;
+        let in_outage = |t: f64| cfg.outages.iter().any(|w| w.contains(t));
+        let quality_ok = |i: usize| {
+            fcfg.accept_quality.is_empty() || fcfg.accept_quality.contains(&gnss.quality[i])
+        };
+        !in_outage(gnss.time_s[i]) && quality_ok(i)
+    }
+
+    /// (horizontal, vertical) σ of fix `i` after the quality scaling, m.
+    fn sigma_fix(&self, i: usize) -> (f64, f64) {
+        let k = self.cfg.filter.quality_scale.factor(self.gnss.quality[i]);
+        let s = self.gnss.sigma_ned_m[i];
+        (s[0].max(s[1]) * k, s[2] * k)
+    }
+
+    /// Fix `i` usable as the start: inside the IMU span (0.05 s after its start, 1 s
+    /// before its end) and usable for the chord.
+    fn usable(&self, i: usize) -> bool {
+        let t = self.gnss.time_s[i];
+        t > self.imu_start + 0.05 && t < self.imu_end - 1.0 && self.fix_ok(i)
+    }
+
+    /// Velocity at fix `i` with its σ: the GNSS velocity when given, else the chord
+    /// between the fixes at the ends of the alignment baseline around it and the turn
+    /// between the chords of its halves; `None` when unusable.
+    fn velocity(&self, i: usize) -> Option<StartVelocity> {
+        let (gnss, cfg) = (self.gnss, self.cfg);
         if let Some(v) = gnss.vel_ned_m_s.as_ref() {
             let (sh, sv) = match gnss.sigma_vel_ned_m_s.as_ref() {
                 Some(s) => (s[i][0].max(s[i][1]), s[i][2]),
                 None => (0.1, 0.1),
             };
-            let k = fcfg.quality_scale.factor(gnss.quality[i]);
+            let k = cfg.filter.quality_scale.factor(gnss.quality[i]);
             return Some(StartVelocity {
                 v: v[i],
                 sigma_h_m_s: sh * k,
@@ -87,10 +160,12 @@ pub(super) fn initialise_at(
                 turn_rad: 0.0,
             });
         }
+        let n = gnss.time_s.len();
+        let half = 0.5 * cfg.align_baseline_s;
         let t = gnss.time_s[i];
         let a = gnss.time_s.partition_point(|&x| x < t - half - 1e-9);
         let b = gnss.time_s.partition_point(|&x| x <= t + half + 1e-9) - 1;
-        if a >= i || b <= i || b >= n || !fix_ok(a) || !fix_ok(b) {
+        if a >= i || b <= i || b >= n || !self.fix_ok(a) || !self.fix_ok(b) {
             return None;
         }
         let (ta, tb) = (gnss.time_s[a], gnss.time_s[b]);
@@ -105,7 +180,7 @@ pub(super) fn initialise_at(
         let mut turn = d2[1].atan2(d2[0]) - d1[1].atan2(d1[0]);
         turn = (turn + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI)
             - std::f64::consts::PI;
-        let ((ha, va), (hb, vb)) = (sigma_fix(a), sigma_fix(b));
+        let ((ha, va), (hb, vb)) = (self.sigma_fix(a), self.sigma_fix(b));
         let ok = v.iter().all(|x| x.is_finite()) && turn.is_finite();
         ok.then(|| StartVelocity {
             v,
@@ -113,11 +188,12 @@ pub(super) fn initialise_at(
             sigma_v_m_s: va.hypot(vb) / (tb - ta),
             turn_rad: turn.abs(),
         })
-    };
-    let usable = |i: usize| {
-        let t = gnss.time_s[i];
-        t > imu_start + 0.05 && t < imu_end - 1.0 && fix_ok(i)
-    };
+    }
+}
+
+/// The given heading, rad (of the given attitude, else the given yaw), if any; an error
+/// when the given attitude or yaw is not finite.
+fn given_yaw(cfg: &SessionConfig) -> Result<Option<f64>, NavError> {
     let given_yaw = cfg
         .initial_attitude_rad
         .map(|a| a[2])
@@ -132,14 +208,28 @@ pub(super) fn initialise_at(
     if given_yaw.is_some_and(|y| !y.is_finite()) {
         return Err(NavError::Config("initial yaw is not finite".into()));
     }
+    Ok(given_yaw)
+}
+
+/// The start fix and its velocity: the fix at `start_s` when given, else the first usable
+/// fix with a velocity (with a given heading) or fast enough with a small enough course σ;
+/// an alignment error naming the speed reached and what to change when there is none.
+fn select_start(
+    fixes: &StartFixes,
+    cfg: &SessionConfig,
+    given_yaw: Option<f64>,
+    start_s: Option<f64>,
+) -> Result<(usize, StartVelocity), NavError> {
+    let gnss = fixes.gnss;
+    let n = gnss.time_s.len();
     let mut fastest: Option<(f64, f64)> = None;
-    let start = (0..n).filter(|&i| usable(i)).find_map(|i| {
+    let start = (0..n).filter(|&i| fixes.usable(i)).find_map(|i| {
         if let Some(t) = start_s {
             return ((gnss.time_s[i] - t).abs() < 1e-6)
-                .then(|| velocity(i).map(|sv| (i, sv)))
+                .then(|| fixes.velocity(i).map(|sv| (i, sv)))
                 .flatten();
         }
-        let sv = velocity(i)?;
+        let sv = fixes.velocity(i)?;
         if given_yaw.is_some() {
             return Some((i, sv));
         }
@@ -150,23 +240,36 @@ pub(super) fn initialise_at(
         (vh > cfg.min_speed_m_s && sv.heading_sigma_rad() <= cfg.max_heading_sigma_rad)
             .then_some((i, sv))
     });
-    let Some((i, sv)) = start else {
+    start.ok_or_else(|| {
         let reached = match fastest {
             Some((v, t)) => format!("the fastest usable fix moves at {v:.2} m/s (t = {t} s)"),
             None => "no fix inside the IMU span has a velocity (GNSS velocity, or fixes on \
                      both sides within the alignment baseline)"
                 .to_string(),
         };
-        return Err(NavError::Alignment(format!(
+        NavError::Alignment(format!(
             "no GNSS fix to initialise the heading from: it needs a horizontal speed above \
              {} m/s with a course σ ≤ {:.1}°, and {reached}; pass the initial heading \
              (--initial-yaw-deg) or lower the alignment speed (--align-min-speed)",
             cfg.min_speed_m_s,
             cfg.max_heading_sigma_rad.to_degrees()
-        )));
-    };
+        ))
+    })
+}
+
+/// Initial attitude and its σ (roll, pitch, yaw), rad: heading given or the course over
+/// ground; tilt given, levelled ([`levelled_tilt`]) or, failing that, zero roll and the
+/// flight-path pitch atan2(−v_D, v_H) at speed, σ 2°.
+fn initial_attitude(
+    imu: &ImuStream,
+    gnss: &GnssFixes,
+    cfg: &SessionConfig,
+    primed_gyro_bias: Option<Vec3>,
+    given_yaw: Option<f64>,
+    sv: &StartVelocity,
+    t_start: f64,
+) -> (Euler, [f64; 3]) {
     let v = sv.v;
-    let t_start = gnss.time_s[i];
     let horiz = v[0].hypot(v[1]);
     let (yaw, sigma_yaw) = match given_yaw {
         Some(y) => (y, cfg.given_attitude_sigma_rad[2]),
@@ -196,20 +299,29 @@ pub(super) fn initialise_at(
         pitch_rad: pitch,
         yaw_rad: yaw,
     };
-    let q_bn = att.to_quat();
-    // Antenna → IMU: r_imu = r_ant − C_bn·l (NED metres, converted with the local radii).
-    let l_n = q_bn.rotate(fcfg.lever_arm_b_m);
+    (att, [sigma_roll, sigma_pitch, sigma_yaw])
+}
+
+/// IMU position (lat, lon rad, h m) at fix `i` from the antenna's, the lever arm `l_n` in
+/// NED: r_imu = r_ant − C_bn·l (NED metres converted with the local radii R_M + h, R_N + h).
+fn imu_position(gnss: &GnssFixes, i: usize, l_n: Vec3) -> (f64, f64, f64) {
     let (lat_a, lon_a, h_a) = (gnss.lat_rad[i], gnss.lon_rad[i], gnss.height_m[i]);
     let rm = meridian_radius_m(lat_a) + h_a;
     let rn = prime_vertical_radius_m(lat_a) + h_a;
-    let nav = NavState {
-        time_s: t_start,
-        lat_rad: lat_a - l_n[0] / rm,
-        lon_rad: lon_a - l_n[1] / (rn * lat_a.cos()),
-        height_m: h_a + l_n[2],
-        vel_ned_m_s: v,
-        q_bn,
-    };
+    (
+        lat_a - l_n[0] / rm,
+        lon_a - l_n[1] / (rn * lat_a.cos()),
+        h_a + l_n[2],
+    )
+}
+
+/// Initial sensor errors and the σ of the 12 sensor states: the primed gyro bias, when
+/// given, with its σ at most 0.05°/s; else zero and the configured σ.
+fn initial_sensors(
+    cfg: &SessionConfig,
+    primed_gyro_bias: Option<Vec3>,
+) -> (SensorErrors, Option<[f64; 12]>) {
+    let fcfg = &cfg.filter;
     let mut sensors = SensorErrors::default();
     let mut sigma_sensors = cfg.initial_sensor_sigma;
     if let Some(b) = primed_gyro_bias {
@@ -225,22 +337,7 @@ pub(super) fn initialise_at(
         }
         sigma_sensors = Some(s);
     }
-    let (sh, sv_pos) = sigma_fix(i);
-    // The chord is the mean velocity over the baseline: allow 0.3 m/s for the change of
-    // velocity over it (and GNSS velocity 0.1 m/s at least).
-    let floor_v = if gnss.vel_ned_m_s.is_some() { 0.1 } else { 0.3 };
-    Ok(InitialState {
-        nav,
-        sensors,
-        sigma_pos_ned_m: [sh.max(0.05), sh.max(0.05), sv_pos.max(0.1)],
-        sigma_vel_ned_m_s: [
-            sv.sigma_h_m_s.max(floor_v),
-            sv.sigma_h_m_s.max(floor_v),
-            sv.sigma_v_m_s.max(floor_v),
-        ],
-        sigma_att_rad: [sigma_roll, sigma_pitch, sigma_yaw],
-        sigma_sensors,
-    })
+    (sensors, sigma_sensors)
 }
 
 /// Roll, pitch (rad) at `t_start` and their σ from levelling the static start of the log

@@ -208,79 +208,20 @@ pub fn run_session(
     let floored;
     let used: &GnssFixes = match cfg.sigma_floor_m {
         Some((h, v)) => {
-            let mut g = gnss.clone();
-            for s in &mut g.sigma_ned_m {
-                s[0] = s[0].max(h);
-                s[1] = s[1].max(h);
-                s[2] = s[2].max(v);
-            }
-            floored = g;
+            floored = with_sigma_floor(gnss, h, v);
             &floored
         }
         None => gnss,
     };
-    let mut fcfg = cfg.filter.clone();
-    let outages_s: Vec<(f64, f64)> = cfg.outages.iter().map(|w| (w.start_s, w.end_s)).collect();
-    if !fcfg.outages_s.is_empty() && fcfg.outages_s != outages_s {
-        return Err(NavError::Config(format!(
-            "two outage lists: the filter configuration names {} window(s) in outages_s, \
-             the session {} in outages; set the windows in SessionConfig::outages only",
-            fcfg.outages_s.len(),
-            outages_s.len()
-        )));
-    }
-    fcfg.outages_s = outages_s;
+    let fcfg = session_filter_config(cfg)?;
     let data_gaps = gnss_data_gaps(&used.time_s);
-    // Convergence periods: after the start t0, and after each outage window and data gap.
-    let excluded_from = |t0: f64, outages: &[OutageWindow]| {
-        let gaps = &data_gaps;
-        let windows: Vec<(f64, f64)> = outages
-            .iter()
-            .map(|w| (w.start_s, w.end_s))
-            .chain(gaps.iter().copied())
-            .collect();
-        move |t: f64| {
-            t < t0 + cfg.converge_s
-                || windows
-                    .iter()
-                    .any(|&(a, b)| t > a && t <= b + cfg.reconverge_s)
-        }
-    };
     let mut floors = Vec::new();
     let mut start_s = None;
     let auto;
     let used = if cfg.auto_sigma_floor {
-        let mut full = cfg.clone();
-        full.outages.clear();
-        let init = initialise(imu, used, &full, primed)?;
-        start_s = Some(init.nav.time_s);
-        let mut ffull = fcfg.clone();
-        ffull.outages_s.clear();
-        let first = run_forward(&imu.epochs, used, init, &ffull)?;
-        // A reset by the gate recovery (an IMU fault, a state far off) is no evidence
-        // about the GNSS: its fixes, from the last accepted one before it to
-        // `reconverge_s` after it, are left out like a convergence period. (Fixes the
-        // gate rejected for a few σ and the clock then forced are kept: they are the
-        // evidence of an optimistic σ the floor is there to find.)
-        let recoveries: Vec<OutageWindow> = first
-            .recoveries
-            .iter()
-            .filter(|r| r.reset)
-            .map(|r| OutageWindow {
-                start_s: r.time_s - r.starved_s,
-                end_s: r.time_s,
-            })
-            .collect();
-        let excluded = excluded_from(init.nav.time_s, &recoveries);
-        floors = super::gnss_floor::estimate(
-            first
-                .updates
-                .iter()
-                .flat_map(|u| u.outcomes.iter().copied()),
-            used,
-            &fcfg.quality_scale,
-            |t| !excluded(t),
-        );
+        let (t, estimated) = first_pass_floors(imu, used, cfg, &fcfg, primed, &data_gaps)?;
+        start_s = Some(t);
+        floors = estimated;
         auto = super::gnss_floor::apply(used, &floors, &fcfg.quality_scale);
         &auto
     } else {
@@ -298,18 +239,8 @@ pub fn run_session(
     let run = run_forward(&imu.epochs, used, init, &fcfg)?;
 
     // Full-GNSS accuracy: prior innovations at accepted position fixes.
-    let excluded = excluded_from(init.nav.time_s, &cfg.outages);
-    let mut sum2 = 0.0;
-    let mut count = 0usize;
-    for u in &run.updates {
-        for o in &u.outcomes {
-            if o.kind == UpdateKind::Position && o.accepted && !excluded(o.time_s) {
-                sum2 += o.innovation[0].powi(2) + o.innovation[1].powi(2);
-                count += 1;
-            }
-        }
-    }
-    let horizontal_rms_m = (count > 0).then(|| ((sum2 / count as f64).sqrt(), count));
+    let excluded = ConvergencePeriods::new(init.nav.time_s, &cfg.outages, &data_gaps, cfg);
+    let horizontal_rms_m = horizontal_rms(&run, &excluded);
 
     let lever = fcfg.lever_arm_b_m;
     let states: Vec<&NavState> = run.epochs.iter().map(|e| &e.nav).collect();
@@ -319,19 +250,7 @@ pub fn run_session(
         .map(|w| outage_errors(&states, &run, gnss, *w, lever))
         .collect();
     let smoothed_outages = if cfg.smooth {
-        let sm = super::filter::smoother::smooth(&run, &init, &fcfg)?;
-        let states: Vec<&NavState> = sm.epochs.iter().map(|e| &e.nav).collect();
-        Some(
-            cfg.outages
-                .iter()
-                .map(|w| {
-                    let mut o = outage_errors(&states, &run, gnss, *w, lever);
-                    o.end_horizontal_m = end_error(&states, gnss, *w, lever);
-                    o.end_vertical_m = None;
-                    o
-                })
-                .collect(),
-        )
+        Some(smoothed_outage_errors(&run, &init, &fcfg, cfg, gnss)?)
     } else {
         None
     };
@@ -345,6 +264,160 @@ pub fn run_session(
         outages,
         smoothed_outages,
     })
+}
+
+/// A copy of `gnss` with the σ floored: horizontal components at `h`, vertical at `v`, m.
+fn with_sigma_floor(gnss: &GnssFixes, h: f64, v: f64) -> GnssFixes {
+    let mut g = gnss.clone();
+    for s in &mut g.sigma_ned_m {
+        s[0] = s[0].max(h);
+        s[1] = s[1].max(h);
+        s[2] = s[2].max(v);
+    }
+    g
+}
+
+/// The session's filter configuration with the session's outage windows in `outages_s`;
+/// an error when the filter configuration names other windows of its own.
+fn session_filter_config(cfg: &SessionConfig) -> Result<FilterConfig, NavError> {
+    let mut fcfg = cfg.filter.clone();
+    let outages_s: Vec<(f64, f64)> = cfg.outages.iter().map(|w| (w.start_s, w.end_s)).collect();
+    if !fcfg.outages_s.is_empty() && fcfg.outages_s != outages_s {
+        return Err(NavError::Config(format!(
+            "two outage lists: the filter configuration names {} window(s) in outages_s, \
+             the session {} in outages; set the windows in SessionConfig::outages only",
+            fcfg.outages_s.len(),
+            outages_s.len()
+        )));
+    }
+    fcfg.outages_s = outages_s;
+    Ok(fcfg)
+}
+
+/// The convergence periods: `converge_s` after the start t0, and `reconverge_s` after
+/// each of some windows (outage windows, data gaps).
+struct ConvergencePeriods {
+    /// Start time, s.
+    t0: f64,
+    /// Length of the period after the start, s.
+    converge_s: f64,
+    /// Length of the period after each window, s.
+    reconverge_s: f64,
+    /// (start, end] of each window, s.
+    windows: Vec<(f64, f64)>,
+}
+
+impl ConvergencePeriods {
+    /// The periods after the start `t0`, each of `outages` and each of the data `gaps`,
+    /// with the lengths of `cfg`.
+    fn new(t0: f64, outages: &[OutageWindow], gaps: &[(f64, f64)], cfg: &SessionConfig) -> Self {
+        let windows: Vec<(f64, f64)> = outages
+            .iter()
+            .map(|w| (w.start_s, w.end_s))
+            .chain(gaps.iter().copied())
+            .collect();
+        ConvergencePeriods {
+            t0,
+            converge_s: cfg.converge_s,
+            reconverge_s: cfg.reconverge_s,
+            windows,
+        }
+    }
+
+    /// `t` falls in a convergence period: before t0 + converge_s, or inside a window
+    /// (start, end + reconverge_s].
+    fn contains(&self, t: f64) -> bool {
+        t < self.t0 + self.converge_s
+            || self
+                .windows
+                .iter()
+                .any(|&(a, b)| t > a && t <= b + self.reconverge_s)
+    }
+}
+
+/// First pass of an estimated σ floor: a run without the outage windows on `used`, its
+/// fix outcomes outside the convergence periods (and the stretches before gate-recovery
+/// resets) give the floors per class ([`super::gnss_floor::estimate`]). Returns the start
+/// time of that pass and the floors.
+fn first_pass_floors(
+    imu: &ImuStream,
+    used: &GnssFixes,
+    cfg: &SessionConfig,
+    fcfg: &FilterConfig,
+    primed: Option<Vec3>,
+    data_gaps: &[(f64, f64)],
+) -> Result<(f64, Vec<super::gnss_floor::ClassFloor>), NavError> {
+    let mut full = cfg.clone();
+    full.outages.clear();
+    let init = initialise(imu, used, &full, primed)?;
+    let mut ffull = fcfg.clone();
+    ffull.outages_s.clear();
+    let first = run_forward(&imu.epochs, used, init, &ffull)?;
+    // A reset by the gate recovery (an IMU fault, a state far off) is no evidence
+    // about the GNSS: its fixes, from the last accepted one before it to
+    // `reconverge_s` after it, are left out like a convergence period. (Fixes the
+    // gate rejected for a few σ and the clock then forced are kept: they are the
+    // evidence of an optimistic σ the floor is there to find.)
+    let recoveries: Vec<OutageWindow> = first
+        .recoveries
+        .iter()
+        .filter(|r| r.reset)
+        .map(|r| OutageWindow {
+            start_s: r.time_s - r.starved_s,
+            end_s: r.time_s,
+        })
+        .collect();
+    let excluded = ConvergencePeriods::new(init.nav.time_s, &recoveries, data_gaps, cfg);
+    let floors = super::gnss_floor::estimate(
+        first
+            .updates
+            .iter()
+            .flat_map(|u| u.outcomes.iter().copied()),
+        used,
+        &fcfg.quality_scale,
+        |t| !excluded.contains(t),
+    );
+    Ok((init.nav.time_s, floors))
+}
+
+/// RMS of the horizontal prior innovations √(Σ(δN² + δE²)/n) at the accepted position
+/// fixes outside the `excluded` periods, m, and their count n; `None` without such fixes.
+fn horizontal_rms(run: &ForwardRun, excluded: &ConvergencePeriods) -> Option<(f64, usize)> {
+    let mut sum2 = 0.0;
+    let mut count = 0usize;
+    for u in &run.updates {
+        for o in &u.outcomes {
+            if o.kind == UpdateKind::Position && o.accepted && !excluded.contains(o.time_s) {
+                sum2 += o.innovation[0].powi(2) + o.innovation[1].powi(2);
+                count += 1;
+            }
+        }
+    }
+    (count > 0).then(|| ((sum2 / count as f64).sqrt(), count))
+}
+
+/// Per-outage errors of the smoothed solution of `run`, the end error taken at the last
+/// IMU epoch inside each window (no vertical end error).
+fn smoothed_outage_errors(
+    run: &ForwardRun,
+    init: &InitialState,
+    fcfg: &FilterConfig,
+    cfg: &SessionConfig,
+    gnss: &GnssFixes,
+) -> Result<Vec<OutageResult>, NavError> {
+    let lever = fcfg.lever_arm_b_m;
+    let sm = super::filter::smoother::smooth(run, init, fcfg)?;
+    let states: Vec<&NavState> = sm.epochs.iter().map(|e| &e.nav).collect();
+    Ok(cfg
+        .outages
+        .iter()
+        .map(|w| {
+            let mut o = outage_errors(&states, run, gnss, *w, lever);
+            o.end_horizontal_m = end_error(&states, gnss, *w, lever);
+            o.end_vertical_m = None;
+            o
+        })
+        .collect())
 }
 
 /// Largest departure of the static mean |f| from 9.8 m/s² for [`static_start`], m/s².

@@ -486,12 +486,62 @@ pub fn run_forward_with(
     opts: &RunOptions,
     observer: &mut dyn FnMut(&[EpochRecord]),
 ) -> Result<ForwardRun, NavError> {
-    let keep_epochs = opts.keep_epochs;
     cfg.validate()?;
     check_gnss(gnss)?;
     let t0 = init.nav.time_s;
-    // First increment that ends after the start; the one before primes the two-sample
-    // corrections when it ends at the start.
+    let (start, prev_inc, nominal_dt) = first_increment(imu, t0)?;
+    let mut f = Eskf::new(init.nav, init.sensors, init.covariance(cfg), prev_inc, cfg)?;
+    let capacity = if opts.keep_epochs {
+        imu.len() - start + gnss.len() + 1
+    } else {
+        2 * OBSERVER_BLOCK
+    };
+    let mut ctx = start_ctx(gnss, cfg, t0, capacity);
+    let mut aids = AidState::new(cfg, nominal_dt, t0)?;
+    let zero = ImuIncrement {
+        time_s: t0,
+        dt_s: 0.0,
+        dtheta_rad: [0.0; 3],
+        dvel_m_s: [0.0; 3],
+    };
+    ctx.run.epochs.push(record(&f, zero));
+    let mut g = apply_start_fixes(&mut ctx, &mut f, t0, opts.skip_gnss_until_s)?;
+    let mut t_prev = t0;
+    let mut observed = 0;
+    for inc in &imu[start..] {
+        let dt = epoch_interval(t_prev, inc.time_s, nominal_dt, cfg.max_gap_factor)?;
+        update_mean_force(&mut ctx, inc, dt);
+        g = propagate_epoch(&mut ctx, &mut f, inc, dt, t_prev, g)?;
+        if aids.enabled {
+            let raw = ImuIncrement { dt_s: dt, ..*inc };
+            aids.after_epoch(&mut f, &raw, &mut ctx)?;
+        }
+        t_prev = inc.time_s;
+        observed = observe_settled(&mut ctx, observer, observed, opts);
+    }
+    let r = &ctx.run;
+    observe(
+        observer,
+        &r.epochs,
+        (observed, r.epochs.len()),
+        r.first_epoch,
+        &r.split_points,
+        opts.observe_split_points,
+    );
+    ctx.run.gnss_skipped += gnss.len() - g;
+    if let Some(d) = aids.detector {
+        ctx.run.standstills = d.finish();
+    }
+    Ok(ctx.run)
+}
+
+/// Index of the first IMU increment that ends after the start `t0`, the increment
+/// ending at `t0` (it primes the two-sample corrections) if any, and the nominal
+/// interval (that of the first increment), s.
+fn first_increment(
+    imu: &[ImuIncrement],
+    t0: f64,
+) -> Result<(usize, Option<ImuIncrement>, f64), NavError> {
     let start = imu.partition_point(|i| i.time_s <= t0 + EPS_T);
     if start >= imu.len() {
         return Err(NavError::ImuTiming {
@@ -510,8 +560,13 @@ pub fn run_forward_with(
             reason: format!("interval {nominal_dt} s"),
         });
     }
-    let mut f = Eskf::new(init.nav, init.sensors, init.covariance(cfg), prev_inc, cfg)?;
-    let mut ctx = Ctx {
+    Ok((start, prev_inc, nominal_dt))
+}
+
+/// The run context at the start `t0`: no fix seen yet, all counters zero, room for
+/// `capacity` records.
+fn start_ctx<'a>(gnss: &'a GnssFixes, cfg: &'a FilterConfig, t0: f64, capacity: usize) -> Ctx<'a> {
+    Ctx {
         gnss,
         cfg,
         gnss_speed: None,
@@ -523,11 +578,7 @@ pub fn run_forward_with(
         gross_in_row: 0,
         count_armed: true,
         run: ForwardRun {
-            epochs: Vec::with_capacity(if keep_epochs {
-                imu.len() - start + gnss.len() + 1
-            } else {
-                2 * OBSERVER_BLOCK
-            }),
+            epochs: Vec::with_capacity(capacity),
             first_epoch: 0,
             split_points: Vec::new(),
             updates: Vec::new(),
@@ -549,22 +600,23 @@ pub fn run_forward_with(
             neg_inv_tau: cfg.neg_inv_tau(),
             coupling_sigma_rad: cfg.gyro_coupling_sigma_rad,
         },
-    };
-    let mut aids = AidState::new(cfg, nominal_dt, t0)?;
-    let zero = ImuIncrement {
-        time_s: t0,
-        dt_s: 0.0,
-        dtheta_rad: [0.0; 3],
-        dvel_m_s: [0.0; 3],
-    };
-    ctx.run.epochs.push(record(&f, zero));
+    }
+}
+
+/// Skips the fixes before the start `t0` (and those at or before `skip_until_s`), then
+/// applies the fixes at the start; returns the index of the first fix after it.
+fn apply_start_fixes(
+    ctx: &mut Ctx,
+    f: &mut Eskf,
+    t0: f64,
+    skip_until_s: Option<f64>,
+) -> Result<usize, NavError> {
+    let gnss = ctx.gnss;
     let ng = gnss.len();
     let mut g = 0;
-    // Fixes before the start are skipped; a fix at the start is applied at once.
     while g < ng {
         let tg = gnss.time_s[g];
-        let before =
-            tg < t0 - EPS_T || tg.is_nan() || opts.skip_gnss_until_s.is_some_and(|s| tg <= s);
+        let before = tg < t0 - EPS_T || tg.is_nan() || skip_until_s.is_some_and(|s| tg <= s);
         if !before {
             break;
         }
@@ -577,127 +629,149 @@ pub fn run_forward_with(
         } else if ctx.quality_skipped(g) {
             ctx.run.gnss_quality_skipped += 1;
         } else {
-            ctx.apply_fix(&mut f, g)?;
+            ctx.apply_fix(f, g)?;
         }
         g += 1;
     }
-    let mut t_prev = t0;
-    let mut observed = 0;
-    for inc in &imu[start..] {
-        let t_end = inc.time_s;
-        let dt = t_end - t_prev;
-        let forward = dt > 0.0;
-        if !forward {
-            return Err(NavError::ImuTiming {
-                time_s: t_end,
-                reason: format!(
-                    "epoch not after the previous one ({t_prev} s): duplicated or out of order"
-                ),
-            });
-        }
-        if dt > cfg.max_gap_factor * nominal_dt {
-            return Err(NavError::ImuTiming {
-                time_s: t_end,
-                reason: format!("gap of {dt} s after {t_prev} s (nominal interval {nominal_dt} s)"),
-            });
-        }
-        let f_now = inc.dvel_m_s.map(|v| v / dt);
-        ctx.f_mean_b = Some(match ctx.f_mean_b {
-            Some(m) => {
-                let a = dt.min(1.0);
-                std::array::from_fn(|k| m[k] + a * (f_now[k] - m[k]))
-            }
-            None => f_now,
+    Ok(g)
+}
+
+/// Interval from the previous epoch `t_prev` to `t_end`, s; an error when the epoch is
+/// not after the previous one or the gap exceeds `max_gap_factor` nominal intervals.
+fn epoch_interval(
+    t_prev: f64,
+    t_end: f64,
+    nominal_dt: f64,
+    max_gap_factor: f64,
+) -> Result<f64, NavError> {
+    let dt = t_end - t_prev;
+    let forward = dt > 0.0;
+    if !forward {
+        return Err(NavError::ImuTiming {
+            time_s: t_end,
+            reason: format!(
+                "epoch not after the previous one ({t_prev} s): duplicated or out of order"
+            ),
         });
-        let mut rest = ImuIncrement { dt_s: dt, ..*inc };
-        let mut t_start = t_prev;
-        let mut done = false;
-        while g < ng && gnss.time_s[g] <= t_end + EPS_T {
-            let tg = gnss.time_s[g];
-            let in_order = tg >= t_start - EPS_T;
-            if !in_order {
-                // Out of order (or NaN) time tag.
-                ctx.run.gnss_skipped += 1;
-                g += 1;
-                continue;
-            }
-            if ctx.withheld(tg) {
-                ctx.run.gnss_withheld += 1;
-                g += 1;
-                continue;
-            }
-            if ctx.quality_skipped(g) {
-                ctx.run.gnss_quality_skipped += 1;
-                g += 1;
-                continue;
-            }
-            if tg >= t_end - EPS_T {
-                if !done {
-                    f.predict(&rest)?;
-                    ctx.run
-                        .epochs
-                        .push(record(&f, f.last_compensated().unwrap_or(rest)));
-                    done = true;
-                    t_start = t_end;
-                }
-            } else if tg > t_start + EPS_T {
-                let alpha = (tg - t_start) / (t_end - t_start);
-                let first = scaled(&rest, alpha, tg, tg - t_start);
-                rest = scaled(&rest, 1.0 - alpha, t_end, t_end - tg);
-                f.predict(&first)?;
+    }
+    if dt > max_gap_factor * nominal_dt {
+        return Err(NavError::ImuTiming {
+            time_s: t_end,
+            reason: format!("gap of {dt} s after {t_prev} s (nominal interval {nominal_dt} s)"),
+        });
+    }
+    Ok(dt)
+}
+
+/// Updates the exponential mean of the raw specific force with the increment `inc` over
+/// `dt`: m ← m + min(dt, 1)·(f − m), time constant 1 s (the first sample starts it).
+fn update_mean_force(ctx: &mut Ctx, inc: &ImuIncrement, dt: f64) {
+    let f_now = inc.dvel_m_s.map(|v| v / dt);
+    ctx.f_mean_b = Some(match ctx.f_mean_b {
+        Some(m) => {
+            let a = dt.min(1.0);
+            std::array::from_fn(|k| m[k] + a * (f_now[k] - m[k]))
+        }
+        None => f_now,
+    });
+}
+
+/// Propagates over one IMU epoch (`t_prev` to the end of `inc`, interval `dt`), splitting
+/// the increment at each fix inside it and applying the fixes from index `g` on that fall
+/// in the epoch; returns the index of the first fix after it.
+fn propagate_epoch(
+    ctx: &mut Ctx,
+    f: &mut Eskf,
+    inc: &ImuIncrement,
+    dt: f64,
+    t_prev: f64,
+    mut g: usize,
+) -> Result<usize, NavError> {
+    let gnss = ctx.gnss;
+    let ng = gnss.len();
+    let t_end = inc.time_s;
+    let mut rest = ImuIncrement { dt_s: dt, ..*inc };
+    let mut t_start = t_prev;
+    let mut done = false;
+    while g < ng && gnss.time_s[g] <= t_end + EPS_T {
+        let tg = gnss.time_s[g];
+        let in_order = tg >= t_start - EPS_T;
+        if !in_order {
+            // Out of order (or NaN) time tag.
+            ctx.run.gnss_skipped += 1;
+            g += 1;
+            continue;
+        }
+        if ctx.withheld(tg) {
+            ctx.run.gnss_withheld += 1;
+            g += 1;
+            continue;
+        }
+        if ctx.quality_skipped(g) {
+            ctx.run.gnss_quality_skipped += 1;
+            g += 1;
+            continue;
+        }
+        if tg >= t_end - EPS_T {
+            if !done {
+                f.predict(&rest)?;
                 ctx.run
                     .epochs
-                    .push(record(&f, f.last_compensated().unwrap_or(first)));
-                let idx = ctx.run.first_epoch + ctx.run.epochs.len() - 1;
-                ctx.run.split_points.push(idx);
-                t_start = tg;
+                    .push(record(f, f.last_compensated().unwrap_or(rest)));
+                done = true;
+                t_start = t_end;
             }
-            ctx.apply_fix(&mut f, g)?;
-            g += 1;
-        }
-        if !done {
-            f.predict(&rest)?;
+        } else if tg > t_start + EPS_T {
+            let alpha = (tg - t_start) / (t_end - t_start);
+            let first = scaled(&rest, alpha, tg, tg - t_start);
+            rest = scaled(&rest, 1.0 - alpha, t_end, t_end - tg);
+            f.predict(&first)?;
             ctx.run
                 .epochs
-                .push(record(&f, f.last_compensated().unwrap_or(rest)));
+                .push(record(f, f.last_compensated().unwrap_or(first)));
+            let idx = ctx.run.first_epoch + ctx.run.epochs.len() - 1;
+            ctx.run.split_points.push(idx);
+            t_start = tg;
         }
-        if aids.enabled {
-            let raw = ImuIncrement { dt_s: dt, ..*inc };
-            aids.after_epoch(&mut f, &raw, &mut ctx)?;
-        }
-        t_prev = t_end;
-        // Only the newest record can still change (updates at its epoch).
-        let settled = ctx.run.epochs.len() - 1;
-        if settled - observed >= OBSERVER_BLOCK {
-            let r = &ctx.run;
-            observe(
-                observer,
-                &r.epochs,
-                (observed, settled),
-                r.first_epoch,
-                &r.split_points,
-                opts.observe_split_points,
-            );
-            observed = settled;
-            if !keep_epochs {
-                ctx.run.epochs.drain(..settled);
-                ctx.run.first_epoch += settled;
-                observed = 0;
-            }
+        ctx.apply_fix(f, g)?;
+        g += 1;
+    }
+    if !done {
+        f.predict(&rest)?;
+        ctx.run
+            .epochs
+            .push(record(f, f.last_compensated().unwrap_or(rest)));
+    }
+    Ok(g)
+}
+
+/// Hands the settled records from `observed` on to the observer once there are at least
+/// [`OBSERVER_BLOCK`] of them, dropping them when the run does not keep its records;
+/// returns the new count of records already handed over (in `ctx.run.epochs`).
+fn observe_settled(
+    ctx: &mut Ctx,
+    observer: &mut dyn FnMut(&[EpochRecord]),
+    mut observed: usize,
+    opts: &RunOptions,
+) -> usize {
+    // Only the newest record can still change (updates at its epoch).
+    let settled = ctx.run.epochs.len() - 1;
+    if settled - observed >= OBSERVER_BLOCK {
+        let r = &ctx.run;
+        observe(
+            observer,
+            &r.epochs,
+            (observed, settled),
+            r.first_epoch,
+            &r.split_points,
+            opts.observe_split_points,
+        );
+        observed = settled;
+        if !opts.keep_epochs {
+            ctx.run.epochs.drain(..settled);
+            ctx.run.first_epoch += settled;
+            observed = 0;
         }
     }
-    let r = &ctx.run;
-    observe(
-        observer,
-        &r.epochs,
-        (observed, r.epochs.len()),
-        r.first_epoch,
-        &r.split_points,
-        opts.observe_split_points,
-    );
-    ctx.run.gnss_skipped += ng - g;
-    if let Some(d) = aids.detector {
-        ctx.run.standstills = d.finish();
-    }
-    Ok(ctx.run)
+    observed
 }
