@@ -259,63 +259,144 @@ pub fn select_outages(
     let (u0, u1) = (t0 + opts.converge_s, t1 - opts.end_margin_s);
     let needed = count as f64 * length_s + (count - 1) as f64 * gap;
     let usable = u1 - u0;
-    let not_enough = || EvalError::NotEnoughData {
-        count,
-        length_s,
-        gap_s: gap,
-        needed_s: needed,
-        usable_s: usable.max(0.0),
-        usable_start_s: u0,
-        usable_end_s: u1,
-        converge_s: opts.converge_s,
-        end_margin_s: opts.end_margin_s,
-    };
     if needed > usable + 1e-9 {
-        return Err(not_enough());
+        return Err(EvalError::NotEnoughData {
+            count,
+            length_s,
+            gap_s: gap,
+            needed_s: needed,
+            usable_s: usable.max(0.0),
+            usable_start_s: u0,
+            usable_end_s: u1,
+            converge_s: opts.converge_s,
+            end_margin_s: opts.end_margin_s,
+        });
     }
     let tl = Timeline::new(reference, &opts.thresholds)?;
-
-    // Candidate starts u0 + i·step, i = 0..=m; windows i and j conflict iff |i − j| < p.
-    let p = ((length_s + gap) / opts.step_s).ceil().max(1.0) as usize;
-    let step = (length_s + gap) / p as f64;
-    let m = ((u1 - length_s - u0) / step + 1e-9).floor().max(0.0) as usize;
-    let start_of = |i: usize| u0 + i as f64 * step;
-    let window_of = |i: usize| OutageWindow {
-        start_s: start_of(i),
-        end_s: start_of(i) + length_s,
-    };
-    let valid: Vec<bool> = (0..=m)
-        .map(|i| {
-            let w = window_of(i);
-            tl.gap_in(w.start_s, w.end_s, opts.max_reference_gap_s)
-                .is_none()
+    let grid = CandidateGrid::new(&tl, (u0, u1), length_s, gap, opts);
+    let present = present_classes(reference, &tl, (u0, u1), opts.min_class_s);
+    let targets = class_targets(&present, count);
+    let chosen = place(&grid, &targets, length_s, opts)?;
+    let mut prev_end = t0;
+    Ok(chosen
+        .into_iter()
+        .map(|(i, d)| {
+            let s = tl.describe(grid.window(i), d, prev_end);
+            prev_end = s.window.end_s;
+            s
         })
-        .collect();
-    // next_valid[i]: first valid index ≥ i (m + 1 = none).
-    let mut next_valid = vec![m + 1; m + 2];
-    for i in (0..=m).rev() {
-        next_valid[i] = if valid[i] { i } else { next_valid[i + 1] };
+        .collect())
+}
+
+/// Candidate starts u0 + i·step, i = 0..=m, where windows i and j conflict iff
+/// |i − j| < p; with each window's validity and class counts.
+struct CandidateGrid {
+    u0: f64,
+    step: f64,
+    length_s: f64,
+    m: usize,
+    p: usize,
+    valid: Vec<bool>,
+    /// next_valid[i]: first valid index ≥ i (m + 1 = none).
+    next_valid: Vec<usize>,
+    shares: Vec<[usize; 5]>,
+}
+
+impl CandidateGrid {
+    /// The grid on the usable span `(u0, u1)`: a step of at most `opts.step_s` that
+    /// divides `length_s + gap` exactly.
+    fn new(
+        tl: &Timeline,
+        (u0, u1): (f64, f64),
+        length_s: f64,
+        gap: f64,
+        opts: &SelectOptions,
+    ) -> CandidateGrid {
+        let p = ((length_s + gap) / opts.step_s).ceil().max(1.0) as usize;
+        let step = (length_s + gap) / p as f64;
+        let m = ((u1 - length_s - u0) / step + 1e-9).floor().max(0.0) as usize;
+        let mut grid = CandidateGrid {
+            u0,
+            step,
+            length_s,
+            m,
+            p,
+            valid: Vec::new(),
+            next_valid: Vec::new(),
+            shares: Vec::new(),
+        };
+        grid.valid = (0..=m)
+            .map(|i| {
+                let w = grid.window(i);
+                tl.gap_in(w.start_s, w.end_s, opts.max_reference_gap_s)
+                    .is_none()
+            })
+            .collect();
+        let mut next_valid = vec![m + 1; m + 2];
+        for i in (0..=m).rev() {
+            next_valid[i] = if grid.valid[i] { i } else { next_valid[i + 1] };
+        }
+        grid.next_valid = next_valid;
+        grid.shares = (0..=m)
+            .map(|i| {
+                let w = grid.window(i);
+                let (a, b) = tl.range(w.start_s, w.end_s);
+                tl.counts(a, b)
+            })
+            .collect();
+        grid
     }
-    let shares: Vec<[usize; 5]> = (0..=m)
-        .map(|i| {
-            let w = window_of(i);
-            let (a, b) = tl.range(w.start_s, w.end_s);
-            tl.counts(a, b)
-        })
-        .collect();
 
-    // Present classes and their durations inside the usable span.
+    /// The window starting at candidate `i`.
+    fn window(&self, i: usize) -> OutageWindow {
+        let start_s = self.u0 + i as f64 * self.step;
+        OutageWindow {
+            start_s,
+            end_s: start_s + self.length_s,
+        }
+    }
+
+    /// Fraction of the reference epochs in window `i` of class `target` (0 for `None`
+    /// or an empty window).
+    fn share(&self, i: usize, target: Option<Dynamics>) -> f64 {
+        match target {
+            Some(d) => {
+                let c = self.shares[i];
+                let n: usize = c.iter().sum();
+                if n == 0 {
+                    0.0
+                } else {
+                    c[d.index()] as f64 / n as f64
+                }
+            }
+            None => 0.0,
+        }
+    }
+}
+
+/// Classes present for at least `min_class_s` (and > 0 s) inside the usable span, with
+/// their durations (epoch count × median interval), shortest first.
+fn present_classes(
+    reference: &NavSolution,
+    tl: &Timeline,
+    (u0, u1): (f64, f64),
+    min_class_s: f64,
+) -> Vec<(Dynamics, f64)> {
     let (ua, ub) = tl.range(u0, u1);
     let dt = median_interval_s(&reference.time_s);
     let totals = tl.counts(ua, ub);
     let mut present: Vec<(Dynamics, f64)> = Dynamics::ALL
         .iter()
         .map(|&d| (d, totals[d.index()] as f64 * dt))
-        .filter(|&(_, s)| s >= opts.min_class_s && s > 0.0)
+        .filter(|&(_, s)| s >= min_class_s && s > 0.0)
         .collect();
     present.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+    present
+}
 
-    // Allocation: one each, rarest first, then D'Hondt on the durations.
+/// The class each of the `count` windows is placed for: one each, rarest first, then
+/// D'Hondt on the durations; `None` for windows left over.
+fn class_targets(present: &[(Dynamics, f64)], count: usize) -> Vec<Option<Dynamics>> {
     let mut alloc: Vec<usize> = vec![0; present.len()];
     for a in alloc.iter_mut().take(count) {
         *a = 1;
@@ -337,56 +418,23 @@ pub fn select_outages(
         targets.extend(std::iter::repeat_n(Some(d), alloc[k]));
     }
     targets.resize(count, None);
+    targets
+}
 
-    // Placement.
+/// Places one window per target in turn: the valid, non-conflicting start with the
+/// largest share of its class, then the most clearance, that leaves room for the
+/// rest. Returns (candidate index, class covered) in time order.
+fn place(
+    grid: &CandidateGrid,
+    targets: &[Option<Dynamics>],
+    length_s: f64,
+    opts: &SelectOptions,
+) -> Result<Vec<(usize, Option<Dynamics>)>, EvalError> {
+    let count = targets.len();
     let mut chosen: Vec<(usize, Option<Dynamics>)> = Vec::with_capacity(count);
     for (placed, &target) in targets.iter().enumerate() {
         let remaining = count - placed - 1;
-        let mut best: Option<(usize, f64, usize)> = None; // (index, share, clearance)
-        for i in 0..=m {
-            if !valid[i] || chosen.iter().any(|&(c, _)| i.abs_diff(c) < p) {
-                continue;
-            }
-            let share = match target {
-                Some(d) => {
-                    let c = shares[i];
-                    let n: usize = c.iter().sum();
-                    if n == 0 {
-                        0.0
-                    } else {
-                        c[d.index()] as f64 / n as f64
-                    }
-                }
-                None => 0.0,
-            };
-            if let Some((_, s, _)) = best
-                && share < s - 1e-12
-            {
-                continue;
-            }
-            let clearance = chosen
-                .iter()
-                .map(|&(c, _)| i.abs_diff(c))
-                .chain([i, m - i])
-                .min()
-                .unwrap_or(0);
-            let better = match best {
-                None => true,
-                Some((_, s, cl)) => share > s + 1e-12 || clearance > cl,
-            };
-            if !better {
-                continue;
-            }
-            if remaining > 0 {
-                let mut with: Vec<usize> = chosen.iter().map(|c| c.0).chain([i]).collect();
-                with.sort_unstable();
-                if capacity(&with, m, p, &next_valid, remaining) < remaining {
-                    continue;
-                }
-            }
-            best = Some((i, share, clearance));
-        }
-        let Some((i, share, _)) = best else {
+        let Some((i, share, _)) = best_start(grid, &chosen, target, remaining) else {
             return Err(EvalError::NoRoom {
                 placed,
                 count,
@@ -397,15 +445,52 @@ pub fn select_outages(
         chosen.push((i, target.filter(|_| share > 0.0)));
     }
     chosen.sort_by_key(|c| c.0);
-    let mut prev_end = t0;
-    Ok(chosen
-        .into_iter()
-        .map(|(i, d)| {
-            let s = tl.describe(window_of(i), d, prev_end);
-            prev_end = s.window.end_s;
-            s
-        })
-        .collect())
+    Ok(chosen)
+}
+
+/// The best start for a window covering `target` next to the `chosen` ones, as
+/// (index, share, clearance), keeping room for `remaining` more windows.
+fn best_start(
+    grid: &CandidateGrid,
+    chosen: &[(usize, Option<Dynamics>)],
+    target: Option<Dynamics>,
+    remaining: usize,
+) -> Option<(usize, f64, usize)> {
+    let (m, p) = (grid.m, grid.p);
+    let mut best: Option<(usize, f64, usize)> = None; // (index, share, clearance)
+    for i in 0..=m {
+        if !grid.valid[i] || chosen.iter().any(|&(c, _)| i.abs_diff(c) < p) {
+            continue;
+        }
+        let share = grid.share(i, target);
+        if let Some((_, s, _)) = best
+            && share < s - 1e-12
+        {
+            continue;
+        }
+        let clearance = chosen
+            .iter()
+            .map(|&(c, _)| i.abs_diff(c))
+            .chain([i, m - i])
+            .min()
+            .unwrap_or(0);
+        let better = match best {
+            None => true,
+            Some((_, s, cl)) => share > s + 1e-12 || clearance > cl,
+        };
+        if !better {
+            continue;
+        }
+        if remaining > 0 {
+            let mut with: Vec<usize> = chosen.iter().map(|c| c.0).chain([i]).collect();
+            with.sort_unstable();
+            if capacity(&with, m, p, &grid.next_valid, remaining) < remaining {
+                continue;
+            }
+        }
+        best = Some((i, share, clearance));
+    }
+    best
 }
 
 /// How many more windows fit (up to `want`) between the sorted `placed` indices on the

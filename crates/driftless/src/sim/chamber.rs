@@ -440,6 +440,89 @@ impl Builder {
             SegmentKind::Move,
         );
     }
+
+    /// The prefix of `n_total` samples: home, tilted 35° about body x (no axis
+    /// vertical), home again, with moves of `n_move` samples between three holds.
+    fn prefix(&mut self, home: Mat3, n_total: u64, n_move: u64) {
+        let n_hold = (n_total - 2 * n_move) / 3;
+        let tilt = rotate(home, [1.0, 0.0, 0.0], 35.0 * DEG);
+        self.hold(n_hold.max(1), SegmentKind::Move);
+        self.move_to(n_move, tilt);
+        self.hold(n_hold.max(1), SegmentKind::Move);
+        self.move_to(n_move, home);
+        self.hold(
+            (n_total - 2 * n_move).saturating_sub(2 * n_hold).max(1),
+            SegmentKind::Move,
+        );
+    }
+
+    /// The rate segments about `axis`, starting at "+axis up" (`at`): one spin of
+    /// `n_spin` samples at `sign`·`omega` per entry of `signs`, with spin-up and
+    /// spin-down ramps of `n_ramp` samples where the rate changes.
+    fn spin_program(
+        &mut self,
+        axis: BodyAxis,
+        at: Mat3,
+        signs: &[f64],
+        omega: f64,
+        n_ramp: u64,
+        n_spin: u64,
+    ) {
+        let dt = self.dt;
+        let u = axis.unit();
+        // Net angle of the program so far, in units of ω·Δt/2.
+        let mut net: i64 = 0;
+        for (i, &sign) in signs.iter().enumerate() {
+            let s = sign as i64;
+            let w = sign * omega;
+            let kind = SegmentKind::Rate {
+                axis,
+                rate_rad_s: w,
+            };
+            // Spin up unless the previous segment turns at the same rate.
+            if i == 0 || signs[i - 1] != sign {
+                let c = self.c;
+                self.push(
+                    n_ramp,
+                    u,
+                    Motion::SpinUp { rate_rad_s: w },
+                    rotate(c, u, 0.5 * w * n_ramp as f64 * dt),
+                    SegmentKind::Move,
+                );
+                net += s * n_ramp as i64;
+            }
+            let c = self.c;
+            self.push(
+                n_spin,
+                u,
+                Motion::Spin { rate_rad_s: w },
+                rotate(c, u, w * n_spin as f64 * dt),
+                kind,
+            );
+            net += 2 * s * n_spin as i64;
+            // Spin down unless the next segment turns at the same rate. When the
+            // net angle of the program is zero (sequential: one ramp pair per
+            // sign) the last spin-down ends exactly at "+axis up"; otherwise
+            // (palindromic: two +ω ramp pairs, one −ω) the table has turned by
+            // ω·spin_s about the vertical axis, which `move_to` then undoes.
+            let last = i + 1 == signs.len();
+            if last || signs[i + 1] != sign {
+                net += s * n_ramp as i64;
+                let end = if last && net == 0 {
+                    at
+                } else {
+                    rotate(self.c, u, 0.5 * w * n_ramp as f64 * dt)
+                };
+                self.push(
+                    n_ramp,
+                    u,
+                    Motion::SpinDown { rate_rad_s: w },
+                    end,
+                    SegmentKind::Move,
+                );
+            }
+        }
+    }
 }
 
 impl ChamberConfig {
@@ -574,14 +657,10 @@ impl ChamberConfig {
         self.position_dwell_s / (per_cycle * f64::from(self.position_cycles.max(1)))
     }
 
-    /// Build the protocol (module docs). Durations are rounded to whole samples.
-    pub fn build(&self) -> Result<ChamberProtocol, SensorSimError> {
-        self.validate()?;
-        let fs = self.sample_rate_hz;
-        let dt = 1.0 / fs;
-        let ns = |d: f64| ((d * fs).round() as u64).max(1);
-        // Positions and signed rates of one step, and the length of each dwell / spin.
-        let (cycle, signs, revs): (Vec<SignedAxis>, &[f64], u32) = match self.step_order {
+    /// Positions of one step's cycle, the signs of its rate segments and the whole
+    /// revolutions of each rate segment (half per segment when palindromic).
+    fn step_schedule(&self) -> (Vec<SignedAxis>, &'static [f64], u32) {
+        match self.step_order {
             StepOrder::Sequential => (
                 SignedAxis::POSITIONS.to_vec(),
                 &[1.0, -1.0],
@@ -596,7 +675,17 @@ impl ChamberConfig {
                 &[1.0, -1.0, -1.0, 1.0],
                 self.rate_revolutions / 2,
             ),
-        };
+        }
+    }
+
+    /// Build the protocol (module docs). Durations are rounded to whole samples.
+    pub fn build(&self) -> Result<ChamberProtocol, SensorSimError> {
+        self.validate()?;
+        let fs = self.sample_rate_hz;
+        let dt = 1.0 / fs;
+        let ns = |d: f64| ((d * fs).round() as u64).max(1);
+        // Positions and signed rates of one step, and the length of each dwell / spin.
+        let (cycle, signs, revs) = self.step_schedule();
         let positions = cycle.repeat(self.position_cycles as usize);
         let n_dwell = ns(self.visit_dwell_s());
         let n_spin = ns(revs as f64 * 360.0 / self.rate_deg_s);
@@ -622,19 +711,7 @@ impl ChamberConfig {
         };
         let mut prefix_n = 0;
         if self.prefix_s > 0.0 {
-            // Home, tilted 35° about body x (no axis vertical), home again: one move.
-            let n_total = ns(self.prefix_s);
-            let n_move = ns(self.move_s);
-            let n_hold = (n_total - 2 * n_move) / 3;
-            let tilt = rotate(home, [1.0, 0.0, 0.0], 35.0 * DEG);
-            b.hold(n_hold.max(1), SegmentKind::Move);
-            b.move_to(n_move, tilt);
-            b.hold(n_hold.max(1), SegmentKind::Move);
-            b.move_to(n_move, home);
-            b.hold(
-                (n_total - 2 * n_move).saturating_sub(2 * n_hold).max(1),
-                SegmentKind::Move,
-            );
+            b.prefix(home, ns(self.prefix_s), ns(self.move_s));
             prefix_n = b.k;
         }
         for (i, &set_c) in self.temperatures_c.iter().enumerate() {
@@ -667,59 +744,7 @@ impl ChamberConfig {
             for axis in BodyAxis::ALL {
                 let at = SignedAxis::new(axis, true).c_bn_up();
                 b.move_to(ns(self.move_s), at);
-                let u = axis.unit();
-                // Net angle of the program so far, in units of ω·Δt/2.
-                let mut net: i64 = 0;
-                for (i, &sign) in signs.iter().enumerate() {
-                    let s = sign as i64;
-                    let w = sign * omega;
-                    let kind = SegmentKind::Rate {
-                        axis,
-                        rate_rad_s: w,
-                    };
-                    // Spin up unless the previous segment turns at the same rate.
-                    if i == 0 || signs[i - 1] != sign {
-                        let c = b.c;
-                        b.push(
-                            n_ramp,
-                            u,
-                            Motion::SpinUp { rate_rad_s: w },
-                            rotate(c, u, 0.5 * w * n_ramp as f64 * dt),
-                            SegmentKind::Move,
-                        );
-                        net += s * n_ramp as i64;
-                    }
-                    let c = b.c;
-                    b.push(
-                        n_spin,
-                        u,
-                        Motion::Spin { rate_rad_s: w },
-                        rotate(c, u, w * n_spin as f64 * dt),
-                        kind,
-                    );
-                    net += 2 * s * n_spin as i64;
-                    // Spin down unless the next segment turns at the same rate. When the
-                    // net angle of the program is zero (sequential: one ramp pair per
-                    // sign) the last spin-down ends exactly at "+axis up"; otherwise
-                    // (palindromic: two +ω ramp pairs, one −ω) the table has turned by
-                    // ω·spin_s about the vertical axis, which `move_to` then undoes.
-                    let last = i + 1 == signs.len();
-                    if last || signs[i + 1] != sign {
-                        net += s * n_ramp as i64;
-                        let end = if last && net == 0 {
-                            at
-                        } else {
-                            rotate(b.c, u, 0.5 * w * n_ramp as f64 * dt)
-                        };
-                        b.push(
-                            n_ramp,
-                            u,
-                            Motion::SpinDown { rate_rad_s: w },
-                            end,
-                            SegmentKind::Move,
-                        );
-                    }
-                }
+                b.spin_program(axis, at, signs, omega, n_ramp, n_spin);
             }
             b.move_to(ns(self.move_s), home);
             steps.push(ChamberStep {
@@ -727,8 +752,14 @@ impl ChamberConfig {
                 duration_s: (b.k - k_start) as f64 * dt,
             });
         }
+        Ok(self.protocol(b, home, steps))
+    }
+
+    /// The protocol from the built pieces and steps: a final hold at `home`, the
+    /// manifest (normal gravity at the site) and the chamber temperature profile.
+    fn protocol(&self, mut b: Builder, home: Mat3, steps: Vec<ChamberStep>) -> ChamberProtocol {
         // Hold at home after the end.
-        let end_s = b.k as f64 * dt;
+        let end_s = b.k as f64 * b.dt;
         b.pieces.push(Piece {
             start_s: end_s,
             duration_s: f64::INFINITY,
@@ -739,7 +770,7 @@ impl ChamberConfig {
         let lat = self.latitude_deg * DEG;
         let manifest = ChamberManifest {
             format_version: MANIFEST_VERSION,
-            sample_rate_hz: fs,
+            sample_rate_hz: self.sample_rate_hz,
             latitude_deg: self.latitude_deg,
             longitude_deg: self.longitude_deg,
             height_m: self.height_m,
@@ -749,7 +780,7 @@ impl ChamberConfig {
             duration_s: end_s,
             segments: b.segments,
         };
-        Ok(ChamberProtocol {
+        ChamberProtocol {
             trajectory: ChamberTrajectory {
                 lat_rad: lat,
                 lon_rad: self.longitude_deg * DEG,
@@ -763,7 +794,7 @@ impl ChamberConfig {
                 initial_c: None,
                 ramp_c_per_min: self.ramp_c_per_min,
             },
-        })
+        }
     }
 }
 

@@ -212,6 +212,206 @@ fn motion(segment: Option<(usize, &'static str)>, key: &'static str, why: String
     SimError::Motion { segment, key, why }
 }
 
+/// Where a motion error occurred: segment index and type, or `None` for the header.
+type SegmentAt = Option<(usize, &'static str)>;
+
+/// `v` when finite, else a motion error on `key`.
+fn finite(at: SegmentAt, key: &'static str, v: f64) -> Result<f64, SimError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(motion(at, key, format!("{v} is not a finite number")))
+    }
+}
+
+/// `v` when finite and > 0, else a motion error on `key`.
+fn positive(at: SegmentAt, key: &'static str, v: f64) -> Result<f64, SimError> {
+    if finite(at, key, v)? > 0.0 {
+        Ok(v)
+    } else {
+        Err(motion(at, key, format!("{v} must be > 0")))
+    }
+}
+
+/// `v` when a finite speed ≥ 0 m/s, else a motion error on `key`.
+fn non_negative_speed(at: SegmentAt, key: &'static str, v: f64) -> Result<f64, SimError> {
+    if finite(at, key, v)? >= 0.0 {
+        Ok(v)
+    } else {
+        Err(motion(at, key, format!("negative speed {v} m/s")))
+    }
+}
+
+/// The one of two alternative keys that is given: (key, value, whether it is `a`).
+fn one_of(
+    at: SegmentAt,
+    a: (&'static str, Option<f64>),
+    b: (&'static str, Option<f64>),
+) -> Result<(&'static str, f64, bool), SimError> {
+    match (a.1, b.1) {
+        (Some(x), None) => Ok((a.0, x, true)),
+        (None, Some(x)) => Ok((b.0, x, false)),
+        _ => Err(motion(
+            at,
+            a.0,
+            format!("give exactly one of {} and {}", a.0, b.0),
+        )),
+    }
+}
+
+/// The current speed `v` when moving, else an error that `what` needs motion.
+fn need_speed(at: SegmentAt, v: f64, key: &'static str, what: &str) -> Result<f64, SimError> {
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(motion(
+            at,
+            key,
+            format!("{what} at zero speed is impossible: accelerate first"),
+        ))
+    }
+}
+
+/// Checks one segment against the current speed `v`, converts it to a
+/// [`DriveSegment`] and updates `v` to the speed at its end.
+fn drive_segment(spec: &SegmentSpec, at: SegmentAt, v: &mut f64) -> Result<DriveSegment, SimError> {
+    Ok(match *spec {
+        SegmentSpec::Stop { duration_s } => {
+            let duration_s = positive(at, "duration_s", duration_s)?;
+            if *v != 0.0 {
+                return Err(motion(
+                    at,
+                    "type",
+                    format!("stop while moving at {v} m/s: brake to 0 first"),
+                ));
+            }
+            DriveSegment::Stop { duration_s }
+        }
+        SegmentSpec::Accelerate {
+            to_speed_m_s,
+            duration_s,
+        } => {
+            let to = non_negative_speed(at, "to_speed_m_s", to_speed_m_s)?;
+            let duration_s = positive(at, "duration_s", duration_s)?;
+            if to <= *v {
+                return Err(motion(
+                    at,
+                    "to_speed_m_s",
+                    format!("{to} m/s is not above the current {v} m/s: use brake"),
+                ));
+            }
+            *v = to;
+            DriveSegment::Speed {
+                to_m_s: to,
+                duration_s,
+            }
+        }
+        SegmentSpec::Brake {
+            to_speed_m_s,
+            duration_s,
+        } => {
+            let to = non_negative_speed(at, "to_speed_m_s", to_speed_m_s)?;
+            let duration_s = positive(at, "duration_s", duration_s)?;
+            if to >= *v {
+                return Err(motion(
+                    at,
+                    "to_speed_m_s",
+                    format!("{to} m/s is not below the current {v} m/s: use accelerate"),
+                ));
+            }
+            *v = to;
+            DriveSegment::Speed {
+                to_m_s: to,
+                duration_s,
+            }
+        }
+        SegmentSpec::Cruise {
+            duration_s,
+            distance_m,
+        } => {
+            let (key, x, by_time) =
+                one_of(at, ("duration_s", duration_s), ("distance_m", distance_m))?;
+            let x = positive(at, key, x)?;
+            let duration_s = if by_time {
+                x
+            } else {
+                x / need_speed(at, *v, key, "cruise by distance")?
+            };
+            DriveSegment::Speed {
+                to_m_s: *v,
+                duration_s,
+            }
+        }
+        SegmentSpec::Turn {
+            angle_deg,
+            rate_deg_s,
+            radius_m,
+        } => turn_segment(at, *v, angle_deg, rate_deg_s, radius_m)?,
+        SegmentSpec::Climb {
+            height_change_m,
+            duration_s,
+            grade_pct,
+        } => climb_segment(at, *v, height_change_m, duration_s, grade_pct)?,
+    })
+}
+
+/// A turn of `angle_deg` at a given rate, or on a given radius at speed `v`
+/// (duration = |angle|·r / v).
+fn turn_segment(
+    at: SegmentAt,
+    v: f64,
+    angle_deg: f64,
+    rate_deg_s: Option<f64>,
+    radius_m: Option<f64>,
+) -> Result<DriveSegment, SimError> {
+    let angle = finite(at, "angle_deg", angle_deg)?;
+    if angle == 0.0 {
+        return Err(motion(at, "angle_deg", "0 is not a turn".into()));
+    }
+    let (key, x, by_rate) = one_of(at, ("rate_deg_s", rate_deg_s), ("radius_m", radius_m))?;
+    let x = positive(at, key, x)?;
+    let duration_s = if by_rate {
+        angle.abs() / x
+    } else {
+        angle.abs() * DEG * x / need_speed(at, v, key, "turn by radius")?
+    };
+    Ok(DriveSegment::Turn {
+        angle_rad: angle * DEG,
+        duration_s,
+    })
+}
+
+/// A height change over a given duration, or at a given grade at speed `v`
+/// (duration = |Δh| / (v · grade/100)).
+fn climb_segment(
+    at: SegmentAt,
+    v: f64,
+    height_change_m: f64,
+    duration_s: Option<f64>,
+    grade_pct: Option<f64>,
+) -> Result<DriveSegment, SimError> {
+    let dh = finite(at, "height_change_m", height_change_m)?;
+    if dh == 0.0 {
+        return Err(motion(
+            at,
+            "height_change_m",
+            "0 is not a climb: use cruise".into(),
+        ));
+    }
+    let speed_now = need_speed(at, v, "type", "climb")?;
+    let (key, x, by_time) = one_of(at, ("duration_s", duration_s), ("grade_pct", grade_pct))?;
+    let x = positive(at, key, x)?;
+    let duration_s = if by_time {
+        x
+    } else {
+        dh.abs() / (speed_now * x / 100.0)
+    };
+    Ok(DriveSegment::Climb {
+        height_change_m: dh,
+        duration_s,
+    })
+}
+
 impl MotionProfile {
     /// Parses TOML text; `name` is used in error messages. Checks syntax, keys and
     /// types only: [`MotionProfile::drive_segments`] checks the motion.
@@ -267,43 +467,7 @@ impl MotionProfile {
     /// Checks the start, the mounting and every segment for possible motion, and
     /// converts the segments to [`DriveSegment`]s (SI units, durations derived).
     pub fn drive_segments(&self) -> Result<Vec<DriveSegment>, SimError> {
-        let s = &self.start;
-        let finite = |seg, key, v: f64| {
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(motion(seg, key, format!("{v} is not a finite number")))
-            }
-        };
-        let positive = |seg, key, v: f64| {
-            if finite(seg, key, v)? > 0.0 {
-                Ok(v)
-            } else {
-                Err(motion(seg, key, format!("{v} must be > 0")))
-            }
-        };
-        let speed = |seg, key, v: f64| {
-            if finite(seg, key, v)? >= 0.0 {
-                Ok(v)
-            } else {
-                Err(motion(seg, key, format!("negative speed {v} m/s")))
-            }
-        };
-        if finite(None, "start.lat_deg", s.lat_deg)?.abs() >= 90.0 {
-            return Err(motion(
-                None,
-                "start.lat_deg",
-                format!("{} outside (−90, 90)", s.lat_deg),
-            ));
-        }
-        finite(None, "start.lon_deg", s.lon_deg)?;
-        finite(None, "start.height_m", s.height_m)?;
-        finite(None, "start.heading_deg", s.heading_deg)?;
-        let mut v = speed(None, "start.speed_m_s", s.speed_m_s)?;
-        finite(None, "mounting.roll_deg", self.mounting.roll_deg)?;
-        finite(None, "mounting.pitch_deg", self.mounting.pitch_deg)?;
-        finite(None, "mounting.yaw_deg", self.mounting.yaw_deg)?;
-        self.gait()?;
+        let mut v = self.checked_start_speed()?;
         if self.segments.is_empty() {
             return Err(motion(
                 None,
@@ -314,144 +478,7 @@ impl MotionProfile {
         let mut out = Vec::with_capacity(self.segments.len());
         for (i, spec) in self.segments.iter().enumerate() {
             let at = Some((i, spec.kind()));
-            let one_of =
-                |a: (&'static str, Option<f64>), b: (&'static str, Option<f64>)| match (a.1, b.1) {
-                    (Some(x), None) => Ok((a.0, x, true)),
-                    (None, Some(x)) => Ok((b.0, x, false)),
-                    _ => Err(motion(
-                        at,
-                        a.0,
-                        format!("give exactly one of {} and {}", a.0, b.0),
-                    )),
-                };
-            let need_speed = |key: &'static str, what: &str| {
-                if v > 0.0 {
-                    Ok(v)
-                } else {
-                    Err(motion(
-                        at,
-                        key,
-                        format!("{what} at zero speed is impossible: accelerate first"),
-                    ))
-                }
-            };
-            let seg = match *spec {
-                SegmentSpec::Stop { duration_s } => {
-                    let duration_s = positive(at, "duration_s", duration_s)?;
-                    if v != 0.0 {
-                        return Err(motion(
-                            at,
-                            "type",
-                            format!("stop while moving at {v} m/s: brake to 0 first"),
-                        ));
-                    }
-                    DriveSegment::Stop { duration_s }
-                }
-                SegmentSpec::Accelerate {
-                    to_speed_m_s,
-                    duration_s,
-                } => {
-                    let to = speed(at, "to_speed_m_s", to_speed_m_s)?;
-                    let duration_s = positive(at, "duration_s", duration_s)?;
-                    if to <= v {
-                        return Err(motion(
-                            at,
-                            "to_speed_m_s",
-                            format!("{to} m/s is not above the current {v} m/s: use brake"),
-                        ));
-                    }
-                    v = to;
-                    DriveSegment::Speed {
-                        to_m_s: to,
-                        duration_s,
-                    }
-                }
-                SegmentSpec::Brake {
-                    to_speed_m_s,
-                    duration_s,
-                } => {
-                    let to = speed(at, "to_speed_m_s", to_speed_m_s)?;
-                    let duration_s = positive(at, "duration_s", duration_s)?;
-                    if to >= v {
-                        return Err(motion(
-                            at,
-                            "to_speed_m_s",
-                            format!("{to} m/s is not below the current {v} m/s: use accelerate"),
-                        ));
-                    }
-                    v = to;
-                    DriveSegment::Speed {
-                        to_m_s: to,
-                        duration_s,
-                    }
-                }
-                SegmentSpec::Cruise {
-                    duration_s,
-                    distance_m,
-                } => {
-                    let (key, x, by_time) =
-                        one_of(("duration_s", duration_s), ("distance_m", distance_m))?;
-                    let x = positive(at, key, x)?;
-                    let duration_s = if by_time {
-                        x
-                    } else {
-                        x / need_speed(key, "cruise by distance")?
-                    };
-                    DriveSegment::Speed {
-                        to_m_s: v,
-                        duration_s,
-                    }
-                }
-                SegmentSpec::Turn {
-                    angle_deg,
-                    rate_deg_s,
-                    radius_m,
-                } => {
-                    let angle = finite(at, "angle_deg", angle_deg)?;
-                    if angle == 0.0 {
-                        return Err(motion(at, "angle_deg", "0 is not a turn".into()));
-                    }
-                    let (key, x, by_rate) =
-                        one_of(("rate_deg_s", rate_deg_s), ("radius_m", radius_m))?;
-                    let x = positive(at, key, x)?;
-                    let duration_s = if by_rate {
-                        angle.abs() / x
-                    } else {
-                        angle.abs() * DEG * x / need_speed(key, "turn by radius")?
-                    };
-                    DriveSegment::Turn {
-                        angle_rad: angle * DEG,
-                        duration_s,
-                    }
-                }
-                SegmentSpec::Climb {
-                    height_change_m,
-                    duration_s,
-                    grade_pct,
-                } => {
-                    let dh = finite(at, "height_change_m", height_change_m)?;
-                    if dh == 0.0 {
-                        return Err(motion(
-                            at,
-                            "height_change_m",
-                            "0 is not a climb: use cruise".into(),
-                        ));
-                    }
-                    let speed_now = need_speed("type", "climb")?;
-                    let (key, x, by_time) =
-                        one_of(("duration_s", duration_s), ("grade_pct", grade_pct))?;
-                    let x = positive(at, key, x)?;
-                    let duration_s = if by_time {
-                        x
-                    } else {
-                        dh.abs() / (speed_now * x / 100.0)
-                    };
-                    DriveSegment::Climb {
-                        height_change_m: dh,
-                        duration_s,
-                    }
-                }
-            };
+            let seg = drive_segment(spec, at, &mut v)?;
             if !(seg.duration_s().is_finite() && seg.duration_s() > 0.0) {
                 return Err(motion(
                     at,
@@ -462,6 +489,27 @@ impl MotionProfile {
             out.push(seg);
         }
         Ok(out)
+    }
+
+    /// Checks the start, the mounting and the gait; returns the start speed (m/s).
+    fn checked_start_speed(&self) -> Result<f64, SimError> {
+        let s = &self.start;
+        if finite(None, "start.lat_deg", s.lat_deg)?.abs() >= 90.0 {
+            return Err(motion(
+                None,
+                "start.lat_deg",
+                format!("{} outside (−90, 90)", s.lat_deg),
+            ));
+        }
+        finite(None, "start.lon_deg", s.lon_deg)?;
+        finite(None, "start.height_m", s.height_m)?;
+        finite(None, "start.heading_deg", s.heading_deg)?;
+        let v = non_negative_speed(None, "start.speed_m_s", s.speed_m_s)?;
+        finite(None, "mounting.roll_deg", self.mounting.roll_deg)?;
+        finite(None, "mounting.pitch_deg", self.mounting.pitch_deg)?;
+        finite(None, "mounting.yaw_deg", self.mounting.yaw_deg)?;
+        self.gait()?;
+        Ok(v)
     }
 
     /// The checked `[gait]` in SI units (`None` without one): a positive step length,

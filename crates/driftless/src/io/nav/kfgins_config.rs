@@ -281,6 +281,148 @@ fn req<'a, 'i>(
         .ok_or_else(|| cx.malformed(at.clone(), format!("missing required key `{key}`")))
 }
 
+/// The top-level mapping of a configuration, for reading and checking its keys.
+struct TopLevel<'a, 'i> {
+    cx: &'a Ctx<'a>,
+    map: &'a saphyr::AnnotatedMapping<'i, MarkedYaml<'i>>,
+    /// Location of the mapping (reported for missing keys).
+    at: Location,
+}
+
+impl<'a, 'i> TopLevel<'a, 'i> {
+    /// A required key's value.
+    fn req(&self, key: &str) -> Result<&'a MarkedYaml<'i>, LogError> {
+        req(self.cx, self.map, key, &self.at)
+    }
+
+    /// A required path: a non-empty string, or a number taken as its text.
+    fn path(&self, key: &str) -> Result<String, LogError> {
+        let cx = self.cx;
+        let v = self.req(key)?;
+        match &v.data {
+            YamlData::Value(Scalar::String(s)) if !s.is_empty() => Ok(s.to_string()),
+            YamlData::Value(Scalar::Integer(i)) => Ok(i.to_string()),
+            YamlData::Value(Scalar::FloatingPoint(f)) => Ok(f.0.to_string()),
+            _ => Err(cx.invalid(
+                cx.at(v),
+                format!("`{key}` must be a path, found {}", describe(v)),
+            )),
+        }
+    }
+
+    /// A required integer (or a string holding one) and its location.
+    fn int(&self, key: &str) -> Result<(i64, Location), LogError> {
+        let cx = self.cx;
+        let v = self.req(key)?;
+        let i = match &v.data {
+            YamlData::Value(Scalar::Integer(i)) => Some(*i),
+            YamlData::Value(Scalar::String(s)) => s.trim().parse::<i64>().ok(),
+            _ => None,
+        };
+        match i {
+            Some(i) => Ok((i, cx.at(v))),
+            None => Err(cx.invalid(
+                cx.at(v),
+                format!("`{key}` must be an integer, found {}", describe(v)),
+            )),
+        }
+    }
+
+    /// A required list of 3 numbers and its location.
+    fn v3(&self, key: &str) -> Result<([f64; 3], Location), LogError> {
+        vec3(self.cx, self.req(key)?, key)
+    }
+
+    /// A required list of 3 standard deviations (each ≥ 0).
+    fn std3(&self, key: &str) -> Result<[f64; 3], LogError> {
+        let v = self.req(key)?;
+        let (a, _) = vec3(self.cx, v, key)?;
+        check_nonneg(self.cx, v, key, &a)?;
+        Ok(a)
+    }
+
+    /// An optional list of 3 standard deviations (each ≥ 0).
+    fn std3_opt(&self, key: &str) -> Result<Option<[f64; 3]>, LogError> {
+        match mapping_get(self.map, key) {
+            None => Ok(None),
+            Some((_, v)) => {
+                let (a, _) = vec3(self.cx, v, key)?;
+                check_nonneg(self.cx, v, key, &a)?;
+                Ok(Some(a))
+            }
+        }
+    }
+
+    /// `imudatalen` (≥ 7), `imudatarate` (> 0 Hz), `starttime` (GPS seconds of week)
+    /// and `endtime` (< 0, or in [starttime, 604800]).
+    fn imu_timing(&self) -> Result<(i64, i64, f64, f64), LogError> {
+        let cx = self.cx;
+        let (imudatalen, n) = self.int("imudatalen")?;
+        if imudatalen < 7 {
+            return Err(cx.invalid(
+                n,
+                format!("`imudatalen` must be ≥ 7 (time + 6 increments), found {imudatalen}"),
+            ));
+        }
+        let (imudatarate, n) = self.int("imudatarate")?;
+        if imudatarate <= 0 {
+            return Err(cx.invalid(
+                n,
+                format!("`imudatarate` must be > 0 Hz, found {imudatarate}"),
+            ));
+        }
+        let (starttime, n) = number(cx, self.req("starttime")?, "starttime")?;
+        if !(0.0..=604_800.0).contains(&starttime) {
+            return Err(cx.invalid(
+                n,
+                format!(
+                    "`starttime` must be GPS seconds of week in [0, 604800], found {starttime}"
+                ),
+            ));
+        }
+        let (endtime, n) = number(cx, self.req("endtime")?, "endtime")?;
+        if endtime >= 0.0 && !(starttime..=604_800.0).contains(&endtime) {
+            return Err(cx.invalid(
+                n,
+                format!(
+                    "`endtime` must be < 0 (to the end) or in [starttime, 604800], found {endtime}"
+                ),
+            ));
+        }
+        Ok((imudatalen, imudatarate, starttime, endtime))
+    }
+
+    /// `initpos`: latitude in [-90, 90] deg, longitude in [-360, 360] deg, height m.
+    fn initpos(&self) -> Result<[f64; 3], LogError> {
+        let (initpos, n) = self.v3("initpos")?;
+        if !(-90.0..=90.0).contains(&initpos[0]) || !(-360.0..=360.0).contains(&initpos[1]) {
+            return Err(self.cx.invalid(
+                n,
+                format!(
+                    "`initpos` must be [latitude deg in [-90, 90], longitude deg, height m], found [{}, {}, {}]",
+                    initpos[0], initpos[1], initpos[2]
+                ),
+            ));
+        }
+        Ok(initpos)
+    }
+
+    /// `initatt`: roll, pitch, yaw in deg with |roll| ≤ 180, |pitch| ≤ 90, |yaw| ≤ 360.
+    fn initatt(&self) -> Result<[f64; 3], LogError> {
+        let (initatt, n) = self.v3("initatt")?;
+        if initatt[0].abs() > 180.0 || initatt[1].abs() > 90.0 || initatt[2].abs() > 360.0 {
+            return Err(self.cx.invalid(
+                n,
+                format!(
+                    "`initatt` must be [roll, pitch, yaw] in deg (|roll| ≤ 180, |pitch| ≤ 90, |yaw| ≤ 360), found [{}, {}, {}]",
+                    initatt[0], initatt[1], initatt[2]
+                ),
+            ));
+        }
+        Ok(initatt)
+    }
+}
+
 /// Parses a KF-GINS configuration file.
 impl KfGinsConfig {
     /// Reads and converts a KF-GINS YAML configuration file.
@@ -371,122 +513,32 @@ impl KfGinsConfigRaw {
             ));
         };
         let unknown = unknown_keys(&cx, map)?;
-        let root_at = cx.at(root);
-        let req = |m, key: &str, at: &Location| req(&cx, m, key, at);
-        let string = |key: &str| -> Result<String, LogError> {
-            let v = req(map, key, &root_at)?;
-            match &v.data {
-                YamlData::Value(Scalar::String(s)) if !s.is_empty() => Ok(s.to_string()),
-                YamlData::Value(Scalar::Integer(i)) => Ok(i.to_string()),
-                YamlData::Value(Scalar::FloatingPoint(f)) => Ok(f.0.to_string()),
-                _ => Err(cx.invalid(
-                    cx.at(v),
-                    format!("`{key}` must be a path, found {}", describe(v)),
-                )),
-            }
+        let top = TopLevel {
+            cx: &cx,
+            map,
+            at: cx.at(root),
         };
-        let imupath = string("imupath")?;
-        let gnsspath = string("gnsspath")?;
-        let outputpath = string("outputpath")?;
-        let int = |key: &str| -> Result<(i64, Location), LogError> {
-            let v = req(map, key, &root_at)?;
-            let i = match &v.data {
-                YamlData::Value(Scalar::Integer(i)) => Some(*i),
-                YamlData::Value(Scalar::String(s)) => s.trim().parse::<i64>().ok(),
-                _ => None,
-            };
-            match i {
-                Some(i) => Ok((i, cx.at(v))),
-                None => Err(cx.invalid(
-                    cx.at(v),
-                    format!("`{key}` must be an integer, found {}", describe(v)),
-                )),
-            }
-        };
-        let (imudatalen, n) = int("imudatalen")?;
-        if imudatalen < 7 {
-            return Err(cx.invalid(
-                n,
-                format!("`imudatalen` must be ≥ 7 (time + 6 increments), found {imudatalen}"),
-            ));
-        }
-        let (imudatarate, n) = int("imudatarate")?;
-        if imudatarate <= 0 {
-            return Err(cx.invalid(
-                n,
-                format!("`imudatarate` must be > 0 Hz, found {imudatarate}"),
-            ));
-        }
-        let (starttime, n) = number(&cx, req(map, "starttime", &root_at)?, "starttime")?;
-        if !(0.0..=604_800.0).contains(&starttime) {
-            return Err(cx.invalid(
-                n,
-                format!(
-                    "`starttime` must be GPS seconds of week in [0, 604800], found {starttime}"
-                ),
-            ));
-        }
-        let (endtime, n) = number(&cx, req(map, "endtime", &root_at)?, "endtime")?;
-        if endtime >= 0.0 && !(starttime..=604_800.0).contains(&endtime) {
-            return Err(cx.invalid(
-                n,
-                format!(
-                    "`endtime` must be < 0 (to the end) or in [starttime, 604800], found {endtime}"
-                ),
-            ));
-        }
-        let v3 = |key: &str| vec3(&cx, req(map, key, &root_at)?, key);
-        let v3opt = |key: &str| -> Result<Option<[f64; 3]>, LogError> {
-            match mapping_get(map, key) {
-                None => Ok(None),
-                Some((_, v)) => {
-                    let (a, _) = vec3(&cx, v, key)?;
-                    check_nonneg(&cx, v, key, &a)?;
-                    Ok(Some(a))
-                }
-            }
-        };
-        let (initpos, n) = v3("initpos")?;
-        if !(-90.0..=90.0).contains(&initpos[0]) || !(-360.0..=360.0).contains(&initpos[1]) {
-            return Err(cx.invalid(
-                n,
-                format!(
-                    "`initpos` must be [latitude deg in [-90, 90], longitude deg, height m], found [{}, {}, {}]",
-                    initpos[0], initpos[1], initpos[2]
-                ),
-            ));
-        }
-        let (initvel, _) = v3("initvel")?;
-        let (initatt, n) = v3("initatt")?;
-        if initatt[0].abs() > 180.0 || initatt[1].abs() > 90.0 || initatt[2].abs() > 360.0 {
-            return Err(cx.invalid(
-                n,
-                format!(
-                    "`initatt` must be [roll, pitch, yaw] in deg (|roll| ≤ 180, |pitch| ≤ 90, |yaw| ≤ 360), found [{}, {}, {}]",
-                    initatt[0], initatt[1], initatt[2]
-                ),
-            ));
-        }
-        let (initgyrbias, _) = v3("initgyrbias")?;
-        let (initaccbias, _) = v3("initaccbias")?;
-        let (initgyrscale, _) = v3("initgyrscale")?;
-        let (initaccscale, _) = v3("initaccscale")?;
-        let std3 = |key: &str| -> Result<[f64; 3], LogError> {
-            let v = req(map, key, &root_at)?;
-            let (a, _) = vec3(&cx, v, key)?;
-            check_nonneg(&cx, v, key, &a)?;
-            Ok(a)
-        };
-        let initposstd = std3("initposstd")?;
-        let initvelstd = std3("initvelstd")?;
-        let initattstd = std3("initattstd")?;
-        let initbgstd = v3opt("initbgstd")?;
-        let initbastd = v3opt("initbastd")?;
-        let initsgstd = v3opt("initsgstd")?;
-        let initsastd = v3opt("initsastd")?;
+        let imupath = top.path("imupath")?;
+        let gnsspath = top.path("gnsspath")?;
+        let outputpath = top.path("outputpath")?;
+        let (imudatalen, imudatarate, starttime, endtime) = top.imu_timing()?;
+        let initpos = top.initpos()?;
+        let (initvel, _) = top.v3("initvel")?;
+        let initatt = top.initatt()?;
+        let (initgyrbias, _) = top.v3("initgyrbias")?;
+        let (initaccbias, _) = top.v3("initaccbias")?;
+        let (initgyrscale, _) = top.v3("initgyrscale")?;
+        let (initaccscale, _) = top.v3("initaccscale")?;
+        let initposstd = top.std3("initposstd")?;
+        let initvelstd = top.std3("initvelstd")?;
+        let initattstd = top.std3("initattstd")?;
+        let initbgstd = top.std3_opt("initbgstd")?;
+        let initbastd = top.std3_opt("initbastd")?;
+        let initsgstd = top.std3_opt("initsgstd")?;
+        let initsastd = top.std3_opt("initsastd")?;
 
-        let imunoise = imu_noise(&cx, map, &root_at)?;
-        let (antlever, _) = v3("antlever")?;
+        let imunoise = imu_noise(&cx, map, &top.at)?;
+        let (antlever, _) = top.v3("antlever")?;
         Ok((
             KfGinsConfigRaw {
                 imupath,

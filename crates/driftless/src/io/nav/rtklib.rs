@@ -213,23 +213,9 @@ pub fn read_rtklib_pos(
 ) -> Result<GnssFixes, LogError> {
     let text = as_utf8(bytes, name)?;
     let mut cols: Option<PosColumns> = None;
-    let mut out = GnssFixes::default();
-    let (mut vel, mut sdv, mut ns) = (Vec::new(), Vec::new(), Vec::new());
-    let mut prev: Option<f64> = None;
-    let mut week0: Option<u16> = None;
+    let mut epochs = PosEpochs::default();
     let mut header_line = 0;
-    // The first and last epoch lines (1-based), which may be cut records.
-    let is_epoch = |l: &[u8]| {
-        let t = l.trim_ascii();
-        !t.is_empty() && !l.starts_with(b"%")
-    };
-    let first_epoch = text
-        .lines()
-        .position(|l| is_epoch(l.as_bytes()))
-        .map(|i| i + 1);
-    let last_epoch = last_data_line(text.as_bytes(), is_epoch)
-        .map(|(ls, _, _)| line_of_offset(text.as_bytes(), ls))
-        .filter(|&l| Some(l) != first_epoch);
+    let (first_epoch, last_epoch) = edge_epoch_lines(text);
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let l = raw.strip_suffix('\r').unwrap_or(raw);
@@ -237,22 +223,8 @@ pub fn read_rtklib_pos(
             continue;
         }
         if l.starts_with('%') {
-            if l.contains("x-ecef(m)") || l.contains("e-baseline(m)") || l.contains("latitude(d'") {
-                return Err(malformed(
-                    Location::line(name, line),
-                    FORMAT_POS,
-                    "only latitude/longitude in decimal degrees is supported (RTKLIB out-solformat=llh, out-degform=deg)",
-                ));
-            }
-            if l.contains("latitude(deg)") {
-                if !out.is_empty() {
-                    return Err(malformed(
-                        Location::line(name, line),
-                        FORMAT_POS,
-                        "a second column header after the first epoch",
-                    ));
-                }
-                cols = Some(parse_pos_header(l, name, line)?);
+            if let Some(c) = parse_pos_comment(l, name, line, !epochs.out.is_empty())? {
+                cols = Some(c);
                 header_line = line;
             }
             continue;
@@ -279,7 +251,10 @@ pub fn read_rtklib_pos(
             let cut = cut_record(&texts, expected, header_line, edge)
                 .filter(|cut| edge == Edge::Last || matches!(cut, Cut::Fields { .. }));
             if let Some(cut) = cut {
-                out.notes.push(note(name, line, edge, &cut, l.as_bytes()));
+                epochs
+                    .out
+                    .notes
+                    .push(note(name, line, edge, &cut, l.as_bytes()));
                 continue;
             }
         }
@@ -292,20 +267,107 @@ pub fn read_rtklib_pos(
                 reference_line: header_line,
             });
         }
-        let t = parse_pos_time(fields[0], fields[1], name, line)?;
-        let w0 = *week0.get_or_insert(t.week);
+        let time_s = epochs.epoch_time(fields[0], fields[1], name, line)?;
+        epochs.push(c, &fields, time_s, name, line, opts)?;
+    }
+    epochs.finish(cols, name)
+}
+
+/// The 1-based lines of the first and the last epoch (the last only when it differs
+/// from the first): the records that may have been cut.
+fn edge_epoch_lines(text: &str) -> (Option<usize>, Option<usize>) {
+    let is_epoch = |l: &[u8]| {
+        let t = l.trim_ascii();
+        !t.is_empty() && !l.starts_with(b"%")
+    };
+    let first_epoch = text
+        .lines()
+        .position(|l| is_epoch(l.as_bytes()))
+        .map(|i| i + 1);
+    let last_epoch = last_data_line(text.as_bytes(), is_epoch)
+        .map(|(ls, _, _)| line_of_offset(text.as_bytes(), ls))
+        .filter(|&l| Some(l) != first_epoch);
+    (first_epoch, last_epoch)
+}
+
+/// A `%` comment line: the parsed columns when it is the column header, `None` for
+/// other comments; an error for unsupported coordinate formats or a header after
+/// epochs (`after_epochs`).
+fn parse_pos_comment(
+    l: &str,
+    name: &str,
+    line: usize,
+    after_epochs: bool,
+) -> Result<Option<PosColumns>, LogError> {
+    if l.contains("x-ecef(m)") || l.contains("e-baseline(m)") || l.contains("latitude(d'") {
+        return Err(malformed(
+            Location::line(name, line),
+            FORMAT_POS,
+            "only latitude/longitude in decimal degrees is supported (RTKLIB out-solformat=llh, out-degform=deg)",
+        ));
+    }
+    if !l.contains("latitude(deg)") {
+        return Ok(None);
+    }
+    if after_epochs {
+        return Err(malformed(
+            Location::line(name, line),
+            FORMAT_POS,
+            "a second column header after the first epoch",
+        ));
+    }
+    parse_pos_header(l, name, line).map(Some)
+}
+
+/// The epochs of a `.pos` file read so far, with the optional columns kept apart
+/// until the header says whether they exist.
+#[derive(Default)]
+struct PosEpochs {
+    out: GnssFixes,
+    vel: Vec<[f64; 3]>,
+    sdv: Vec<[f64; 3]>,
+    ns: Vec<u8>,
+    prev: Option<f64>,
+    week0: Option<u16>,
+}
+
+impl PosEpochs {
+    /// Parses an epoch's time as seconds since the first epoch's GPS week and checks it
+    /// follows the previous epoch.
+    fn epoch_time(
+        &mut self,
+        f0: Field<'_>,
+        f1: Field<'_>,
+        name: &str,
+        line: usize,
+    ) -> Result<f64, LogError> {
+        let t = parse_pos_time(f0, f1, name, line)?;
+        let w0 = *self.week0.get_or_insert(t.week);
         if t.week < w0 {
             return Err(LogError::NonMonotonicTime {
                 at: Location::line(name, line),
                 field: 1,
                 name: "GPST".into(),
                 time_s: t.seconds_since_week(w0),
-                previous_s: prev.unwrap_or(0.0),
+                previous_s: self.prev.unwrap_or(0.0),
             });
         }
         let time_s = t.seconds_since_week(w0);
-        check_time_order(time_s, prev, name, line, 1, "GPST")?;
-        prev = Some(time_s);
+        check_time_order(time_s, self.prev, name, line, 1, "GPST")?;
+        self.prev = Some(time_s);
+        Ok(time_s)
+    }
+
+    /// Parses and checks the value fields of an epoch at `time_s` and appends it.
+    fn push(
+        &mut self,
+        c: &PosColumns,
+        fields: &[Field<'_>],
+        time_s: f64,
+        name: &str,
+        line: usize,
+        opts: &GnssReadOptions,
+    ) -> Result<(), LogError> {
         let mut v = Vec::with_capacity(c.names.len());
         for (k, f) in fields[2..].iter().enumerate() {
             v.push(parse_num(*f, name, line, k + 3, &c.names[k])?);
@@ -322,6 +384,7 @@ pub fn read_rtklib_pos(
                 &c.names[k],
             )?;
         }
+        let out = &mut self.out;
         out.time_s.push(time_s);
         out.lat_rad.push(v[c.lat].to_radians());
         out.lon_rad.push(v[c.lon].to_radians());
@@ -330,10 +393,11 @@ pub fn read_rtklib_pos(
         out.quality
             .push(small_int(v[c.q], 7, fld(c.q), name, line, "Q")?);
         if let Some(k) = c.ns {
-            ns.push(small_int(v[k], u8::MAX, fld(k), name, line, "ns")?);
+            self.ns
+                .push(small_int(v[k], u8::MAX, fld(k), name, line, "ns")?);
         }
         if let Some([n, e, u]) = c.vel {
-            vel.push([v[n], v[e], -v[u]]);
+            self.vel.push([v[n], v[e], -v[u]]);
         }
         if let Some(ks) = c.sdv {
             let mut s = [0.0; 3];
@@ -346,27 +410,34 @@ pub fn read_rtklib_pos(
                     &c.names[k],
                 )?;
             }
-            sdv.push(s);
+            self.sdv.push(s);
         }
+        Ok(())
     }
-    if out.is_empty() {
-        return Err(LogError::Empty {
-            at: Location::input(name),
-        });
+
+    /// The fixes, with the optional columns the header `cols` has; an error when no
+    /// epoch was read.
+    fn finish(self, cols: Option<PosColumns>, name: &str) -> Result<GnssFixes, LogError> {
+        let mut out = self.out;
+        if out.is_empty() {
+            return Err(LogError::Empty {
+                at: Location::input(name),
+            });
+        }
+        out.gps_week = self.week0;
+        if let Some(c) = cols {
+            if c.ns.is_some() {
+                out.n_sats = Some(self.ns);
+            }
+            if c.vel.is_some() {
+                out.vel_ned_m_s = Some(self.vel);
+            }
+            if c.sdv.is_some() {
+                out.sigma_vel_ned_m_s = Some(self.sdv);
+            }
+        }
+        Ok(out)
     }
-    out.gps_week = week0;
-    if let Some(c) = cols {
-        if c.ns.is_some() {
-            out.n_sats = Some(ns);
-        }
-        if c.vel.is_some() {
-            out.vel_ned_m_s = Some(vel);
-        }
-        if c.sdv.is_some() {
-            out.sigma_vel_ned_m_s = Some(sdv);
-        }
-    }
-    Ok(out)
 }
 
 /// Size of the file-position field in `.tag` records.

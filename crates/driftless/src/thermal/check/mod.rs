@@ -381,18 +381,7 @@ fn fmt_span(s: &TimeSpan) -> String {
 pub fn check_log(log: &ImuLog, label: &str, opts: &CheckOptions) -> ThermalCheck {
     let n = log.len();
     let mut findings = Vec::new();
-    let both = |kind, message: String, span| Finding {
-        kind,
-        ramp: Impact::Block,
-        soak: Impact::Block,
-        span,
-        message,
-    };
-    let time: Vec<f64> = match &log.time_s {
-        Some(t) if t.len() == n => t.clone(),
-        _ if log.tau0_s > 0.0 => (0..n).map(|i| i as f64 * log.tau0_s).collect(),
-        _ => Vec::new(),
-    };
+    let time = sample_times(log);
     let gaps = gap_summary(log, &time);
     let mut report = ThermalCheck {
         label: label.to_owned(),
@@ -408,7 +397,7 @@ pub fn check_log(log: &ImuLog, label: &str, opts: &CheckOptions) -> ThermalCheck
         fit_for_soak: false,
     };
     if n < 2 || time.len() != n {
-        findings.push(both(
+        findings.push(blocks_both(
             FindingKind::NoData,
             format!(
                 "{label}: {n} sample(s){}: a thermal fit needs a time-stamped recording \
@@ -426,7 +415,7 @@ pub fn check_log(log: &ImuLog, label: &str, opts: &CheckOptions) -> ThermalCheck
     let gyro = log.triad_of(Quantity::AngularRate);
     let accel = log.triad_of(Quantity::SpecificForce);
     if gyro.is_none() && accel.is_none() {
-        findings.push(both(
+        findings.push(blocks_both(
             FindingKind::NoInertial,
             format!(
                 "{label}: no three gyro or three accelerometer channels with units: nothing \
@@ -436,7 +425,7 @@ pub fn check_log(log: &ImuLog, label: &str, opts: &CheckOptions) -> ThermalCheck
         ));
     }
     let Some(temp) = temp else {
-        findings.push(both(
+        findings.push(blocks_both(
             FindingKind::NoTemperature,
             format!(
                 "{label}: no temperature channel: a thermal model needs the sensor \
@@ -448,24 +437,78 @@ pub fn check_log(log: &ImuLog, label: &str, opts: &CheckOptions) -> ThermalCheck
         return finish(report, findings);
     };
     let tc = &temp.values;
-    if let Some(i) = tc.iter().position(|v| !v.is_finite()) {
-        findings.push(both(
-            FindingKind::BadTemperature,
-            format!(
-                "{label}: temperature of sample {i} (t = {:.3} s) is {}: remove or repair \
-                 that sample",
-                time[i], tc[i]
-            ),
-            Some(TimeSpan {
-                start_s: time[i],
-                end_s: time[i],
-            }),
-        ));
+    if let Some(finding) = bad_temperature_finding(&time, tc, label) {
+        findings.push(finding);
         return finish(report, findings);
     }
     let ts = temperature_summary(tc, opts);
+    temperature_findings(&ts, label, opts, &mut findings);
+    let flags = motion_flags(&time, gyro, accel, opts);
+    let motion = flags.as_ref().map(|f| f.3.clone());
+    let heating = heating_profile(&time, tc, &ts, accel, flags.as_ref(), opts);
+    findings.extend(uneven_heating_finding(&heating, label, opts));
+    if let Some(m) = &motion
+        && m.moving_fraction > 0.0
+    {
+        findings.push(motion_finding(m, label, opts));
+    }
+    findings.extend(gap_finding(log, &report.gaps, label, opts));
+    soak_findings(&heating, label, opts, &mut findings);
+    report.temperature = Some(ts);
+    report.heating = Some(heating);
+    report.motion = motion;
+    finish(report, findings)
+}
+
+/// A finding that blocks both the ramp and the soak fit.
+fn blocks_both(kind: FindingKind, message: String, span: Option<TimeSpan>) -> Finding {
+    Finding {
+        kind,
+        ramp: Impact::Block,
+        soak: Impact::Block,
+        span,
+        message,
+    }
+}
+
+/// Sample times of `log`: its time column when complete, else `i·tau0_s`; empty when
+/// neither is known.
+fn sample_times(log: &ImuLog) -> Vec<f64> {
+    let n = log.len();
+    match &log.time_s {
+        Some(t) if t.len() == n => t.clone(),
+        _ if log.tau0_s > 0.0 => (0..n).map(|i| i as f64 * log.tau0_s).collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// The blocking finding for the first non-finite temperature reading, if any.
+fn bad_temperature_finding(time: &[f64], tc: &[f64], label: &str) -> Option<Finding> {
+    let i = tc.iter().position(|v| !v.is_finite())?;
+    Some(blocks_both(
+        FindingKind::BadTemperature,
+        format!(
+            "{label}: temperature of sample {i} (t = {:.3} s) is {}: remove or repair \
+             that sample",
+            time[i], tc[i]
+        ),
+        Some(TimeSpan {
+            start_s: time[i],
+            end_s: time[i],
+        }),
+    ))
+}
+
+/// Findings on the temperature readings alone: too little rise, coarse resolution and
+/// too few populated one-degree levels, in that order.
+fn temperature_findings(
+    ts: &TemperatureSummary,
+    label: &str,
+    opts: &CheckOptions,
+    findings: &mut Vec<Finding>,
+) {
     if ts.rise_c < opts.min_rise_c {
-        findings.push(both(
+        findings.push(blocks_both(
             FindingKind::TooLittleRise,
             format!(
                 "{label}: temperature {:.2}–{:.2} °C, a rise of {:.2} °C; a thermal model \
@@ -506,88 +549,97 @@ pub fn check_log(log: &ImuLog, label: &str, opts: &CheckOptions) -> ThermalCheck
             ),
         });
     }
-    let flags = motion_flags(&time, gyro, accel, opts);
-    let motion = flags.as_ref().map(|f| f.3.clone());
-    let heating = heating_profile(&time, tc, &ts, accel, flags.as_ref(), opts);
-    if heating.unevenness > opts.uneven_ratio {
-        findings.push(Finding {
-            kind: FindingKind::UnevenHeating,
-            ramp: Impact::Warn,
-            soak: Impact::None,
-            span: None,
-            message: format!(
-                "{label}: uneven heating: {:.0} to {:.0} s per degree (10th–90th percentile, \
-                 ratio {:.1} > {:.1}; |dT/dt| {:.3}–{:.3} °C/min over {:.0}-s windows); the ramp \
-                 fit takes one point per degree so slow stretches do not dominate, but the \
-                 sensor's thermal lag differs along the ramp — heat at a steady rate if you can",
-                heating.dwell_p10_p90_s[0],
-                heating.dwell_p10_p90_s[1],
-                heating.unevenness,
-                opts.uneven_ratio,
-                heating.rate_p10_c_per_min,
-                heating.rate_p90_c_per_min,
-                heating.window_s
-            ),
-        });
+}
+
+/// The ramp warning when the dwell per degree varies by more than `opts.uneven_ratio`.
+fn uneven_heating_finding(
+    heating: &HeatingProfile,
+    label: &str,
+    opts: &CheckOptions,
+) -> Option<Finding> {
+    (heating.unevenness > opts.uneven_ratio).then(|| Finding {
+        kind: FindingKind::UnevenHeating,
+        ramp: Impact::Warn,
+        soak: Impact::None,
+        span: None,
+        message: format!(
+            "{label}: uneven heating: {:.0} to {:.0} s per degree (10th–90th percentile, \
+             ratio {:.1} > {:.1}; |dT/dt| {:.3}–{:.3} °C/min over {:.0}-s windows); the ramp \
+             fit takes one point per degree so slow stretches do not dominate, but the \
+             sensor's thermal lag differs along the ramp — heat at a steady rate if you can",
+            heating.dwell_p10_p90_s[0],
+            heating.dwell_p10_p90_s[1],
+            heating.unevenness,
+            opts.uneven_ratio,
+            heating.rate_p10_c_per_min,
+            heating.rate_p90_c_per_min,
+            heating.window_s
+        ),
+    })
+}
+
+/// The finding for a log that moved: a ramp warning when brief, a ramp block above
+/// `opts.max_moving_fraction`.
+fn motion_finding(m: &MotionSummary, label: &str, opts: &CheckOptions) -> Finding {
+    let block = m.moving_fraction > opts.max_moving_fraction;
+    Finding {
+        kind: FindingKind::Motion,
+        ramp: if block { Impact::Block } else { Impact::Warn },
+        soak: Impact::None,
+        span: m.moving_spans.first().copied(),
+        message: format!(
+            "{label}: the sensor moved in {:.2} % of {:.0}-s windows (gyro change up to \
+             {:.3} rad/s, tilt up to {:.1}°), first at {}: a ramp needs the board \
+             untouched in one orientation{}",
+            100.0 * m.moving_fraction,
+            m.window_s,
+            m.max_gyro_change_rad_s,
+            m.max_tilt_rad.to_degrees(),
+            m.moving_spans.first().map_or("–".into(), fmt_span),
+            if block {
+                " — record the ramp again without moving it, or cut the log to a static part"
+            } else {
+                " (brief, tolerated)"
+            }
+        ),
     }
-    if let Some(m) = &motion
-        && m.moving_fraction > 0.0
-    {
-        let block = m.moving_fraction > opts.max_moving_fraction;
-        findings.push(Finding {
-            kind: FindingKind::Motion,
-            ramp: if block { Impact::Block } else { Impact::Warn },
-            soak: Impact::None,
-            span: m.moving_spans.first().copied(),
-            message: format!(
-                "{label}: the sensor moved in {:.2} % of {:.0}-s windows (gyro change up to \
-                 {:.3} rad/s, tilt up to {:.1}°), first at {}: a ramp needs the board \
-                 untouched in one orientation{}",
-                100.0 * m.moving_fraction,
-                m.window_s,
-                m.max_gyro_change_rad_s,
-                m.max_tilt_rad.to_degrees(),
-                m.moving_spans.first().map_or("–".into(), fmt_span),
-                if block {
-                    " — record the ramp again without moving it, or cut the log to a static part"
-                } else {
-                    " (brief, tolerated)"
-                }
-            ),
-        });
+}
+
+/// The warning on time gaps in the log, if it has any.
+fn gap_finding(
+    log: &ImuLog,
+    gaps: &GapSummary,
+    label: &str,
+    opts: &CheckOptions,
+) -> Option<Finding> {
+    if gaps.count == 0 {
+        return None;
     }
-    if report.gaps.count > 0 {
-        let big = report.gaps.max_temperature_jump_c > opts.gap_temperature_c;
-        let first = log.gaps.first().map(|g| TimeSpan {
-            start_s: g.start_s,
-            end_s: g.start_s + g.duration_s,
-        });
-        findings.push(Finding {
-            kind: FindingKind::Gaps,
-            ramp: Impact::Warn,
-            soak: Impact::Warn,
-            span: first,
-            message: format!(
-                "{label}: {} time gap(s), longest {:.3} s, {:.1} s in all (first at {}); \
-                 the temperature moves up to {:.2} °C across one{}",
-                report.gaps.count,
-                report.gaps.longest_s,
-                report.gaps.total_s,
-                first.as_ref().map_or("–".into(), fmt_span),
-                report.gaps.max_temperature_jump_c,
-                if big {
-                    ": temperature bins are missing there"
-                } else {
-                    ""
-                }
-            ),
-        });
-    }
-    soak_findings(&heating, label, opts, &mut findings);
-    report.temperature = Some(ts);
-    report.heating = Some(heating);
-    report.motion = motion;
-    finish(report, findings)
+    let big = gaps.max_temperature_jump_c > opts.gap_temperature_c;
+    let first = log.gaps.first().map(|g| TimeSpan {
+        start_s: g.start_s,
+        end_s: g.start_s + g.duration_s,
+    });
+    Some(Finding {
+        kind: FindingKind::Gaps,
+        ramp: Impact::Warn,
+        soak: Impact::Warn,
+        span: first,
+        message: format!(
+            "{label}: {} time gap(s), longest {:.3} s, {:.1} s in all (first at {}); \
+             the temperature moves up to {:.2} °C across one{}",
+            gaps.count,
+            gaps.longest_s,
+            gaps.total_s,
+            first.as_ref().map_or("–".into(), fmt_span),
+            gaps.max_temperature_jump_c,
+            if big {
+                ": temperature bins are missing there"
+            } else {
+                ""
+            }
+        ),
+    })
 }
 
 fn finish(mut r: ThermalCheck, findings: Vec<Finding>) -> ThermalCheck {
