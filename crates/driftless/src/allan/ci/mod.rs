@@ -18,7 +18,9 @@ pub mod noise_id;
 
 pub use chi2::{chi2_cdf, chi2_quantile};
 pub use greenhall::edf_greenhall;
-pub use noise_id::{NoiseId, NoiseIdMethod, acf_noise_id, b1_noise_id, lag1_acf};
+pub use noise_id::NoiseId;
+pub use noise_id::NoiseIdMethod;
+pub use noise_id::{acf_noise_id, b1_noise_id, lag1_acf};
 
 use super::{AllanError, Estimator};
 

@@ -68,10 +68,8 @@ mod plan;
 mod read;
 mod time;
 
-pub use header::TIME_COLUMN_NAMES;
-pub use options::{
-    ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, ParseSpecError, TextOptions,
-};
+pub use options::ParseSpecError;
+pub use options::{ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, TextOptions};
 use read::read_impl;
 
 /// Reads a delimited text log from a file (streamed, never loaded whole).
