@@ -72,13 +72,12 @@ pub use config::{FitConfig, FitOptions};
 pub(crate) use config::{GM_MAX_RECORD_FRACTION, GM_MIN_SAMPLES, MODEL_ERROR_FLOOR};
 pub use range::{FitRange, FitRangeSpec, RangeSource, auto_range_candidates, short_tau_coloured};
 pub(crate) use result::CHI2_RED_GOOD;
-pub use result::GaussMarkovTerm;
-pub use result::NotIdentifiable;
-pub use result::UpperLimit;
-pub use result::{CHI2_RED_WARN, NoiseFit, Term, TermKind, chi2_verdict};
-pub use slopes::SlopeReadings;
+pub use result::{
+    CHI2_RED_WARN, GaussMarkovTerm, NoiseFit, NotIdentifiable, Term, TermKind, UpperLimit,
+    chi2_verdict,
+};
 use slopes::slope_alpha;
-pub use slopes::slope_readings;
+pub use slopes::{SlopeReadings, slope_readings};
 pub(crate) use solve::golden_max;
 use solve::{IrlsSolution, covariance, golden_max_tol, irls, upper_limit};
 

@@ -39,15 +39,13 @@ mod file;
 mod selection;
 mod table;
 
-pub use discrete::DiscreteGaussMarkov;
-pub use discrete::DiscreteNoise;
-pub use discrete::{bias_floor_tau, discrete_noise, model_minimum_tau};
-pub use display::DisplayValue;
-pub use display::{display_terms, display_units};
+pub use discrete::{
+    DiscreteGaussMarkov, DiscreteNoise, bias_floor_tau, discrete_noise, model_minimum_tau,
+};
+pub use display::{DisplayValue, display_terms, display_units};
 pub(crate) use display::{fmt_num, si_term_units, term_label};
 pub(crate) use selection::CURVE_PRECISION;
-pub use selection::Unsupported;
-pub use selection::{auto_fit_end, fit_supported_terms, least_supported_term, widen_for_the_start};
+pub use selection::{auto_fit_end, fit_supported_terms, widen_for_the_start};
 use selection::{auto_range, user_indices};
 pub use table::fit_quality_lines;
 
@@ -477,6 +475,7 @@ impl<'a> ChannelFit<'a> {
 
 #[cfg(test)]
 mod tests {
+    use super::selection::{Unsupported, least_supported_term};
     use super::*;
     use crate::allan::fit::{
         BIAS_AVAR_COEF, GaussMarkovTerm, Term, UpperLimit, gauss_markov_avar_peak,

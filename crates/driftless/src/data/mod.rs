@@ -18,8 +18,6 @@ mod span;
 mod validate;
 
 pub use imu::{Channel, ImuLog, Quantity, TimeGap};
-pub use nav::ImuErrors;
-pub use nav::NavStd;
-pub use nav::{GnssFixes, ImuIncrements, NavSolution, quality};
+pub use nav::{GnssFixes, ImuErrors, ImuIncrements, NavSolution, NavStd, quality};
 pub use span::TimeSpan;
 pub use validate::DataError;

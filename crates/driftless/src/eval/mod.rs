@@ -27,11 +27,8 @@ pub mod reference;
 pub mod select;
 
 pub use accuracy::horizontal_rms_m;
-pub use dynamics::ClassMix;
-pub use dynamics::{Dynamics, DynamicsThresholds, classify};
-pub use metrics::OutageErrors;
-pub use metrics::OutageReport;
-pub use metrics::{MetricOptions, outage_errors};
+pub use dynamics::{ClassMix, Dynamics, DynamicsThresholds, classify};
+pub use metrics::{MetricOptions, OutageErrors, OutageReport, outage_errors};
 pub use select::{SelectOptions, SelectedOutage, check_outages, resolve_outages, select_outages};
 
 use crate::nav::outage::{OutageError, OutageWindow};

@@ -40,13 +40,9 @@ mod recorded;
 mod thermal;
 mod vehicle;
 
-pub use recorded::RatesWithTemperature;
-pub use recorded::RecordedVehicle;
-pub use thermal::ThermalStage;
-pub use thermal::thermal_stage;
-pub use vehicle::CaseRun;
-pub use vehicle::VehicleRun;
-pub use vehicle::{filter_noise, vehicle_run};
+pub use recorded::{RatesWithTemperature, RecordedVehicle};
+pub use thermal::{ThermalStage, thermal_stage};
+pub use vehicle::{CaseRun, VehicleRun, filter_noise, vehicle_run};
 
 /// The ways the vehicle IMU data are processed, from least to most compensated.
 ///

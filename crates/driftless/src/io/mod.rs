@@ -40,11 +40,10 @@ pub mod units;
 pub mod write;
 pub(crate) mod yaml;
 
-pub use autopilot::AutopilotImu;
-pub use autopilot::AutopilotImuLogs;
 #[cfg(feature = "autopilot-logs")]
 pub use autopilot::{
-    AutopilotFormat, detect_format, imu_logs_from_autopilot, imu_logs_from_autopilot_file,
+    AutopilotFormat, AutopilotImu, AutopilotImuLogs, detect_format, imu_logs_from_autopilot,
+    imu_logs_from_autopilot_file,
 };
 #[cfg(feature = "autopilot-logs")]
 pub use dataflash::{imu_logs_from_dataflash, parse_dataflash};
@@ -52,13 +51,10 @@ pub use dataflash::{imu_logs_from_dataflash, parse_dataflash};
 pub use ulog::{imu_logs_from_ulog, parse_ulog};
 
 pub use binary::{read_binary, read_binary_file, write_binary, write_binary_file};
-pub use error::Location;
-pub use error::LogError;
+pub use error::{Location, LogError};
 pub use input::{InputFormat, LogInput, MAX_CONFIG_BYTES, read_config_text};
 pub use log::{Channel, ImuLog, Quantity, TimeGap};
-pub use rosbag::BagFormat;
-pub use rosbag::Ros2BagFolder;
-pub use rosbag::read_rosbag_file;
+pub use rosbag::{BagFormat, read_rosbag_file};
 pub use text::{
     ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, TextOptions, read_text,
     read_text_bytes, read_text_file,

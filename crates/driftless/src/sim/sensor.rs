@@ -65,14 +65,11 @@ use driftless_model::thermal::ThermalPoly;
 
 use super::noise::{StaticNoiseConfig, generate};
 use super::rng::{Rng, splitmix64};
-pub use super::sensor_config::AccelErrors;
-pub use super::sensor_config::AxisNoise;
-pub use super::sensor_config::GyroErrors;
 pub(crate) use super::sensor_config::MAX_MISALIGNMENT_RAD;
-pub use super::sensor_config::TemperatureSensor;
-pub use super::sensor_config::{CHANNEL_NAMES, SensorConfig};
-pub use super::sensor_data::Signal;
-pub use super::sensor_data::{IdealImu, OutputKind, SensorOutput, ideal_sample};
+pub use super::sensor_config::{
+    AccelErrors, AxisNoise, CHANNEL_NAMES, GyroErrors, SensorConfig, TemperatureSensor,
+};
+pub use super::sensor_data::{IdealImu, OutputKind, SensorOutput, Signal, ideal_sample};
 use super::sensor_error::{SensorSimError, check_finite, check_nonneg};
 
 /// One triad, validated and compiled.

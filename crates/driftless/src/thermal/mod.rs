@@ -28,11 +28,7 @@ pub mod ramp;
 pub mod soak;
 pub mod stats;
 
-pub use fit::BandPoint;
-pub use fit::CrossValidation;
-pub use fit::OrderAdvice;
-pub use fit::OrderRow;
 pub use fit::{
-    FitOptions, HeldOut, NoiseScale, ThermalFit, ThermalFitError, advise_order, cross_validate,
-    fit, fit_correlated, held_out,
+    BandPoint, CrossValidation, FitOptions, HeldOut, NoiseScale, OrderAdvice, OrderRow, ThermalFit,
+    ThermalFitError, advise_order, cross_validate, fit, fit_correlated, held_out,
 };

@@ -21,7 +21,7 @@ pub(crate) const MIN_B1_POINTS: usize = 4;
 
 /// How an alpha was identified.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum NoiseIdMethod {
+pub(crate) enum NoiseIdMethod {
     /// Lag-1 autocorrelation: `d` differences were taken, δ is the final
     /// r1/(1 + r1), and `p` = −2(δ + d) is the phase-PSD exponent estimate.
     Lag1Acf {
@@ -42,7 +42,7 @@ pub enum NoiseIdMethod {
 
 /// Result of [`identify_noise`](super::identify_noise).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NoiseId {
+pub(crate) struct NoiseId {
     /// Integer noise exponent α (S_y ∝ f^α), clamped to the allowed range.
     pub alpha: i32,
     /// Unrounded estimate of α (for the ACF method p + 2; for B1 the class value).
@@ -102,7 +102,7 @@ fn detrend(x: &mut [f64], deg: usize) {
 /// offset and linear drift) is removed, then the series is differenced until
 /// δ = r1/(1 + r1) < 0.25 or d = `dmax`. The phase-PSD exponent is p = −2(δ + d) and
 /// α = round(p) + 2. Returns `None` with fewer than `MIN_ACF_POINTS` decimated points.
-pub fn acf_noise_id(x: &[f64], m: usize, dmax: u32) -> Option<NoiseId> {
+pub(crate) fn acf_noise_id(x: &[f64], m: usize, dmax: u32) -> Option<NoiseId> {
     let m = m.max(1);
     let mut z: Vec<f64> = x.iter().step_by(m).take(MAX_ACF_POINTS).copied().collect();
     if z.len() < MIN_ACF_POINTS {
@@ -174,7 +174,7 @@ fn avar_mvar(x: &[f64], m: usize) -> Option<(f64, f64)> {
 /// B1 / R(n) identification for short series (SP 1065 §5.6). `None` with fewer than
 /// `MIN_B1_POINTS` frequency averages. The B1 ratio cannot see below α = −2 (the Allan
 /// variance diverges there), so it returns α ∈ −2..=2.
-pub fn b1_noise_id(x: &[f64], m: usize) -> Option<NoiseId> {
+pub(crate) fn b1_noise_id(x: &[f64], m: usize) -> Option<NoiseId> {
     let m = m.max(1);
     if x.len() < 2 {
         return None;

@@ -161,7 +161,7 @@ where
 
 /// What a term the data do not support is reported as instead of a value.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Unsupported {
+pub(crate) enum Unsupported {
     /// Its interval reaches zero: the upper end of the interval is the upper limit.
     UpperLimit(UpperLimit),
     /// Its value cannot be what the term describes (see [`least_supported_term`]).
@@ -175,7 +175,7 @@ pub enum Unsupported {
 /// * otherwise, of the terms whose interval reaches zero, the one with the smallest
 ///   significance θ/(z·s_θ) (θ the squared coefficient, z·s_θ its interval half-width,
 ///   so θ/(z·s_θ) = v²/(hi² − v²)): an upper limit at its interval's upper end.
-pub fn least_supported_term(
+pub(crate) fn least_supported_term(
     fit: &NoiseFit,
     step: Option<f64>,
     tau0_s: f64,
@@ -229,7 +229,7 @@ pub fn least_supported_term(
 }
 
 /// The fit with physically possible, resolved terms only, by backward elimination: fit
-/// with `cfg`, drop the [`least_supported_term`], refit without it and repeat until every
+/// with `cfg`, drop the `least_supported_term`, refit without it and repeat until every
 /// remaining term stands. Each dropped term is reported (upper limit or not
 /// identifiable) from the fit that still had it; the returned fit's values, χ²_red and
 /// model curve are those of the terms that stand, so the saved model is the model

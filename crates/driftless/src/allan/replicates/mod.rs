@@ -52,8 +52,7 @@ mod display;
 mod meta;
 
 pub use combine::combine_curves;
-pub use meta::MetaAnalysis;
-pub use meta::{cochran_dersimonian_laird, log_standard_error};
+pub use meta::{MetaAnalysis, cochran_dersimonian_laird, log_standard_error};
 
 /// The terms compared, in model order.
 const TERMS: [TermKind; 6] = [

@@ -25,25 +25,19 @@ pub mod types {
     pub use crate::data::nav::*;
 }
 
-pub use gpstime::GpsTime;
-pub use gpstime::ParseTimeBaseError;
-pub use gpstime::TimeBaseError;
-pub use gpstime::{TimeBase, gps_minus_utc_s};
-pub use kfgins::KfGinsOutputWriter;
-pub use kfgins::KfGinsRow;
+pub use gpstime::{GpsTime, ParseTimeBaseError, TimeBase, TimeBaseError, gps_minus_utc_s};
 pub use kfgins::{
-    GnssReadOptions, ZeroSigma, read_kfgins_gnss, read_kfgins_gnss_file, read_kfgins_imu,
-    read_kfgins_imu_file, write_kfgins_gnss, write_kfgins_imu, write_kfgins_imu_err,
-    write_kfgins_nav, write_kfgins_outputs, write_kfgins_std,
+    GnssReadOptions, KfGinsOutputWriter, KfGinsRow, ZeroSigma, read_kfgins_gnss,
+    read_kfgins_gnss_file, read_kfgins_imu, read_kfgins_imu_file, write_kfgins_gnss,
+    write_kfgins_imu, write_kfgins_imu_err, write_kfgins_nav, write_kfgins_outputs,
+    write_kfgins_std,
 };
 pub use kfgins_config::{ImuNoise, KfGinsConfig, KfGinsConfigRaw};
 pub use rtklib::{
     FposSize, TaggedTimes, TickMapping, TimeTag, map_ticks_to_gps, read_rtklib_pos,
     read_rtklib_pos_file, read_rtklib_tag, read_rtklib_tag_file, write_rtklib_pos,
 };
-pub use types::ImuErrors;
-pub use types::NavStd;
-pub use types::{GnssFixes, ImuIncrements, NavSolution, quality};
+pub use types::{GnssFixes, ImuErrors, ImuIncrements, NavSolution, NavStd, quality};
 
 use crate::io::{Location, LogError};
 

@@ -25,7 +25,5 @@ pub mod folder;
 pub mod guard;
 
 pub use file::{AtomicFile, partial_owner, write};
-pub use folder::FolderLock;
-pub use folder::{claim_folder, is_stale_partial, lock_folder, remove_stale_partials};
-pub use guard::OutputError;
-pub use guard::{refuse_folder_in_use, refuse_same_file};
+pub use folder::{FolderLock, claim_folder, is_stale_partial, lock_folder, remove_stale_partials};
+pub use guard::{OutputError, refuse_folder_in_use, refuse_same_file};

@@ -42,8 +42,7 @@ use std::path::Path;
 
 use super::error::{Location, LogError};
 use super::log::{Channel, ImuLog, Quantity};
-pub use folder::Ros2BagFolder;
-pub use folder::ros2_bag_folder;
+pub(crate) use folder::{Ros2BagFolder, ros2_bag_folder};
 
 /// Which robotics log format an input holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -122,7 +121,7 @@ pub fn read_rosbag(
 
 /// [`read_rosbag_file`] of a bag whose first storage file is `first` (opened, named
 /// `name`) and, for a ROS 2 bag folder, the rest of `folder.storage` after it.
-pub fn read_rosbag_parts(
+pub(crate) fn read_rosbag_parts(
     first: std::fs::File,
     name: &str,
     folder: Option<&Ros2BagFolder>,

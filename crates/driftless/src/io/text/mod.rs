@@ -68,8 +68,9 @@ mod plan;
 mod read;
 mod time;
 
-pub use options::ParseSpecError;
-pub use options::{ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, TextOptions};
+pub use options::{
+    ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, ParseSpecError, TextOptions,
+};
 use read::read_impl;
 
 /// Reads a delimited text log from a file (streamed, never loaded whole).

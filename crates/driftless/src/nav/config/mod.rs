@@ -23,8 +23,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-pub use keys::Key;
-pub use keys::{KEYS, ValueKind, key_by_path};
+pub use keys::{KEYS, Key, ValueKind, key_by_path};
 use quantity::{Kind, parse_quantity};
 use validate::*;
 

@@ -41,14 +41,12 @@ pub use align::{
     AlignConfig, Alignment, coarse_align_static, heading_from_gnss_velocity, level_static,
 };
 pub use eskf::{Eskf, UpdateKind, UpdateOutcome};
-pub use model::QualityScale;
-pub use model::{FilterConfig, Gate, GaussMarkov, ImuNoise, Transition};
+pub use model::{FilterConfig, Gate, GaussMarkov, ImuNoise, QualityScale, Transition};
 pub use run::{
     EpochRecord, ForwardRun, InitialState, RecoveryEvent, RecoveryTrigger, RunOptions,
     UpdateRecord, run_forward, run_forward_observed, run_forward_with,
 };
-pub use smoother::SmoothedEpoch;
-pub use smoother::{SmoothedRun, smooth, smooth_with_covariances};
+pub use smoother::{SmoothedEpoch, SmoothedRun, smooth, smooth_with_covariances};
 pub use state::{N_STATES, SensorErrors};
 
 /// Errors of the navigation filter, its driver and the alignment.
