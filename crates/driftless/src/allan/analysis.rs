@@ -72,7 +72,7 @@ pub struct ChannelResult {
     pub fast: bool,
     /// Lag-1 autocorrelation of the rates averaged over τ (non-overlapping blocks of m
     /// samples of the longest segment), per point; NaN where fewer than
-    /// [`MIN_ACF_BLOCKS`] blocks exist. ≈ 0 for white noise, negative where quantization
+    /// `MIN_ACF_BLOCKS` blocks exist. ≈ 0 for white noise, negative where quantization
     /// dominates, positive where the sensor's own filtering colours the noise (see
     /// [`super::fit::auto_range_candidates`]).
     #[serde(default)]
@@ -80,18 +80,18 @@ pub struct ChannelResult {
 }
 
 /// Fewest averaged blocks for which [`rate_lag1_acf`] is computed.
-pub const MIN_ACF_BLOCKS: usize = 30;
+pub(crate) const MIN_ACF_BLOCKS: usize = 30;
 /// Most averaged blocks [`rate_lag1_acf`] reads (from the start of the record): its
 /// standard error is then ≤ 1/√65536 = 0.004, well inside the 0.02 the fit-range gate
 /// asks for, and the short-τ points no longer read the whole record each.
-pub const MAX_ACF_BLOCKS: usize = 65_536;
+pub(crate) const MAX_ACF_BLOCKS: usize = 65_536;
 
 /// Lag-1 autocorrelation of the rates averaged over non-overlapping blocks of `m`
 /// samples, read from phase `x` (x_k = τ0·Σ y): ȳ_j = (x_{(j+1)m} − x_{jm})/(mτ0), then
 /// r₁ = Σ (ȳ_j − ȳ)(ȳ_{j+1} − ȳ) / Σ (ȳ_j − ȳ)² (Box & Jenkins 1976 §2.1.5; the statistic
 /// behind the noise identification of Riley & Greenhall 2004). NaN when fewer than
-/// [`MIN_ACF_BLOCKS`] blocks exist or the blocks are constant; at most the first
-/// [`MAX_ACF_BLOCKS`] blocks are read. The scale τ0 cancels.
+/// `MIN_ACF_BLOCKS` blocks exist or the blocks are constant; at most the first
+/// `MAX_ACF_BLOCKS` blocks are read. The scale τ0 cancels.
 pub fn rate_lag1_acf(x: &[f64], m: usize) -> f64 {
     if m == 0 || x.len() < 2 {
         return f64::NAN;

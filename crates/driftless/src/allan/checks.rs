@@ -9,7 +9,7 @@
 //!   90th to the 10th percentile of s_w² is about q₀.₉/q₀.₁ of χ²_{W−1} (Wilson–Hilferty:
 //!   q_p(k) ≈ k(1 − 2/(9k) + z_p√(2/(9k)))³); 1.4 for W = 100. Motion (a vehicle turning,
 //!   stopping, vibrating) makes the short-term variance change by orders of magnitude. A
-//!   ratio above [`NON_STATIONARY_FACTOR`] times the expected one is reported.
+//!   ratio above `NON_STATIONARY_FACTOR` times the expected one is reported.
 //! * Record length: a fitted bias-instability, rate-random-walk, rate-ramp or
 //!   Gauss–Markov term is *read* where it dominates the fitted model; where that is only
 //!   at τ > T/10 (T the record length), fewer than 10 independent averages carry it, and
@@ -23,7 +23,7 @@ use super::fit::{NoiseFit, TermKind};
 
 /// How many times the expected percentile ratio of the window variances counts as
 /// non-stationary.
-pub const NON_STATIONARY_FACTOR: f64 = 10.0;
+pub(crate) const NON_STATIONARY_FACTOR: f64 = 10.0;
 
 /// χ²_k quantile at standard-normal quantile z (Wilson–Hilferty).
 pub(crate) fn chi2_quantile(k: f64, z: f64) -> f64 {
@@ -43,7 +43,7 @@ pub struct Stationarity {
 }
 
 impl Stationarity {
-    /// True when the ratio exceeds [`NON_STATIONARY_FACTOR`] × the expected one.
+    /// True when the ratio exceeds `NON_STATIONARY_FACTOR` × the expected one.
     pub fn is_static(&self) -> bool {
         self.ratio <= NON_STATIONARY_FACTOR * self.expected_ratio || self.ratio.is_nan()
     }

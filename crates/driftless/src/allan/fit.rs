@@ -17,7 +17,7 @@
 //! minimises Σ w_i (σ̂²_i − m_i(θ))² with w_i = 1/(m_i²(2/ν_i + f²)) where m_i is the
 //! **model** value (weighting by the data instead biases the fit low, because low
 //! estimates get large weights) and f a relative model-error floor
-//! ([`MODEL_ERROR_FLOOR`]: no point counts as more precise than f, so the few short-τ
+//! (`MODEL_ERROR_FLOOR`: no point counts as more precise than f, so the few short-τ
 //! points with EDF of 10⁵–10⁶ cannot decide the fit alone; the floor only bites where
 //! 2/ν < f², i.e. ν > 2/f²), subject to θ ≥ 0. The weights are updated from the model and the
 //! non-negative least squares (NNLS) problem re-solved until the model stops changing
@@ -68,16 +68,13 @@ mod slopes;
 mod solve;
 
 use config::GM_LN_T_TOL;
-pub use config::{
-    FitConfig, FitOptions, GM_MAX_RECORD_FRACTION, GM_MIN_SAMPLES, MODEL_ERROR_FLOOR,
-};
-pub use range::{
-    ACF_COLOURED, AUTO_RANGE_MAX_M, FitRange, FitRangeSpec, RangeSource, auto_range_candidates,
-    short_tau_coloured,
-};
+pub use config::{FitConfig, FitOptions};
+pub(crate) use config::{GM_MAX_RECORD_FRACTION, GM_MIN_SAMPLES, MODEL_ERROR_FLOOR};
+pub use range::{FitRange, FitRangeSpec, RangeSource, auto_range_candidates, short_tau_coloured};
+pub(crate) use result::CHI2_RED_GOOD;
 pub use result::{
-    CHI2_RED_GOOD, CHI2_RED_WARN, GaussMarkovTerm, NoiseFit, NotIdentifiable, Term, TermKind,
-    UpperLimit, chi2_verdict,
+    CHI2_RED_WARN, GaussMarkovTerm, NoiseFit, NotIdentifiable, Term, TermKind, UpperLimit,
+    chi2_verdict,
 };
 use slopes::slope_alpha;
 pub use slopes::{SlopeReadings, slope_readings};
@@ -200,9 +197,9 @@ pub fn fit_noise(
 /// [`fit_noise`] with the record's sample interval and length (which bound a
 /// Gauss-Markov correlation time to what the record can show) and the weights'
 /// model-error floor. A correlation time that ends at a bound of its search — from
-/// the longer of [`GM_MIN_SAMPLES`]·τ0 and the curve's shortest τ (a shorter one falls
+/// the longer of `GM_MIN_SAMPLES`·τ0 and the curve's shortest τ (a shorter one falls
 /// as 1/τ over the whole curve, like white noise, and would trade places with N) to the
-/// shorter of [`GM_MAX_RECORD_FRACTION`]·record and ten times the longest τ — is
+/// shorter of `GM_MAX_RECORD_FRACTION`·record and ten times the longest τ — is
 /// reported in [`NoiseFit::not_identifiable`] and the model refitted without the term.
 pub fn fit_noise_opts(
     tau: &[f64],
@@ -843,7 +840,7 @@ mod tests {
         let c = auto_range_candidates(&m);
         let cm: Vec<usize> = c.iter().map(|&i| m[i]).collect();
         assert_eq!(&cm[..5], &[1, 2, 3, 5, 8]);
-        assert!(c.iter().all(|&i| m[i] <= AUTO_RANGE_MAX_M));
+        assert!(c.iter().all(|&i| m[i] <= range::AUTO_RANGE_MAX_M));
         assert!(c.windows(2).all(|w| 2 * m[w[1]] >= 3 * m[w[0]]));
     }
 

@@ -464,7 +464,7 @@ impl Found<'_> {
 /// `confidence`, and per point `tau`, `m`, `n`, `dev`, `dev_lo`, `dev_hi`, `alpha`, `edf`,
 /// `rate_acf1`.
 #[derive(Clone, Copy, Debug)]
-pub struct CurvesDocument<'a> {
+pub(crate) struct CurvesDocument<'a> {
     /// The curves.
     pub results: &'a [ChannelResult],
     /// Unit of each curve's channel (same order).
@@ -515,7 +515,7 @@ impl Serialize for CurveDocument<'_> {
 /// of an Allan fit carrying its χ²_red verdict (`chi2_verdict`, `chi2_warning`,
 /// [`chi2_verdict`]).
 #[derive(Clone, Copy, Debug)]
-pub struct NoiseDocument<'a> {
+pub(crate) struct NoiseDocument<'a> {
     /// The model.
     pub model: &'a NoiseModel,
     /// Whether it is an Allan fit (the verdict applies).

@@ -44,11 +44,8 @@ pub use discrete::{
 };
 pub use display::{DisplayValue, display_terms, display_units};
 pub(crate) use display::{fmt_num, si_term_units, term_label};
-pub use selection::{
-    AUTO_RANGE_MIN_POINTS, CURVE_PRECISION, CURVE_PRECISION_CONFIDENCE,
-    QUANTIZATION_RESOLUTION_FACTOR, Unsupported, auto_fit_end, fit_supported_terms,
-    least_supported_term, widen_for_the_start,
-};
+pub(crate) use selection::CURVE_PRECISION;
+pub use selection::{auto_fit_end, fit_supported_terms, widen_for_the_start};
 use selection::{auto_range, user_indices};
 pub use table::fit_quality_lines;
 
@@ -478,6 +475,7 @@ impl<'a> ChannelFit<'a> {
 
 #[cfg(test)]
 mod tests {
+    use super::selection::{Unsupported, least_supported_term};
     use super::*;
     use crate::allan::fit::{
         BIAS_AVAR_COEF, GaussMarkovTerm, Term, UpperLimit, gauss_markov_avar_peak,

@@ -4,32 +4,32 @@
 //!
 //! All on rate (frequency) data of a sensor at rest, in SI after the reader's conversion:
 //!
-//! * gyro: |mean| ≤ [`MAX_GYRO_BIAS_RAD_S`] (any MEMS turn-on bias is far below 1 rad/s;
+//! * gyro: |mean| ≤ `MAX_GYRO_BIAS_RAD_S` (any MEMS turn-on bias is far below 1 rad/s;
 //!   the Earth turns at 7.3·10⁻⁵ rad/s); white noise read from the sample spread,
 //!   N ≈ s·√τ₀ (the white term dominates the sample variance at the sampling interval for
-//!   a MEMS gyro; an upper bound otherwise), between [`MIN_ARW_DEG_RT_H`] (a navigation-grade
-//!   gyro) and [`MAX_ARW_DEG_RT_H`] (the noisiest consumer parts are near 10 °/√h);
+//!   a MEMS gyro; an upper bound otherwise), between `MIN_ARW_DEG_RT_H` (a navigation-grade
+//!   gyro) and `MAX_ARW_DEG_RT_H` (the noisiest consumer parts are near 10 °/√h);
 //! * accelerometer: with three accelerometer channels, the magnitude of the mean specific
 //!   force at rest is g ≈ 9.81 m/s² (9.78–9.83 on the Earth's surface); outside
-//!   [`ACCEL_AT_REST_M_S2`] the unit or the static assumption is wrong, and the ratio to g
+//!   `ACCEL_AT_REST_M_S2` the unit or the static assumption is wrong, and the ratio to g
 //!   says which unit it looks like; per channel, white noise as for the gyro against
-//!   [`MAX_VRW_M_S_RT_H`].
+//!   `MAX_VRW_M_S_RT_H`.
 //!
 //! Each finding is one warning naming the channel, the figure, and what to check.
 
 use crate::io::Quantity;
 
 /// Largest plausible |mean| of a gyro at rest, rad/s (≈ 57 °/s).
-pub const MAX_GYRO_BIAS_RAD_S: f64 = 1.0;
+pub(crate) const MAX_GYRO_BIAS_RAD_S: f64 = 1.0;
 /// Largest plausible angle random walk, °/√h.
-pub const MAX_ARW_DEG_RT_H: f64 = 30.0;
+pub(crate) const MAX_ARW_DEG_RT_H: f64 = 30.0;
 /// Smallest plausible angle random walk for a MEMS-class log, °/√h (a navigation-grade
 /// ring-laser gyro is near 0.001 °/√h).
-pub const MIN_ARW_DEG_RT_H: f64 = 5e-4;
+pub(crate) const MIN_ARW_DEG_RT_H: f64 = 5e-4;
 /// Largest plausible velocity random walk, m/s/√h.
-pub const MAX_VRW_M_S_RT_H: f64 = 3.0;
+pub(crate) const MAX_VRW_M_S_RT_H: f64 = 3.0;
 /// Range of |mean specific force| that is a sensor at rest on the Earth, m/s².
-pub const ACCEL_AT_REST_M_S2: (f64, f64) = (9.0, 10.6);
+pub(crate) const ACCEL_AT_REST_M_S2: (f64, f64) = (9.0, 10.6);
 
 /// One channel to check: name, quantity, the unit the file gave, the SI values.
 #[derive(Clone, Copy, Debug)]

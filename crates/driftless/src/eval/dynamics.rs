@@ -147,7 +147,7 @@ impl DynamicsThresholds {
 
 /// The smoothed signals of the module docs, one value per epoch.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct DynamicsSignals {
+pub(crate) struct DynamicsSignals {
     /// Mean horizontal speed over the window, m/s.
     pub speed_m_s: Vec<f64>,
     /// Longitudinal (tangential) acceleration, m/s².

@@ -179,14 +179,14 @@ pub fn from_nav_states<'a>(states: impl IntoIterator<Item = &'a NavState>) -> Na
 
 /// Horizontal speed below which a fix-derived reference has no heading, m/s: with RTK
 /// velocity noise of ~2 cm/s the course over ground is good to ≈ 1° at 1 m/s.
-pub const COURSE_MIN_SPEED_M_S: f64 = 1.0;
+pub(crate) const COURSE_MIN_SPEED_M_S: f64 = 1.0;
 
 /// A reference trajectory from GNSS fixes (RTK, as on `drive_0708`, where the fixes are
 /// the only reference). Velocity: the fixes' own velocity, or else the central difference
 /// of the neighbouring fixes (one-sided at the ends; a neighbour more than 2.5 s away is
 /// not used). Attitude of a land vehicle without side slip: roll 0, pitch the flight-path
 /// angle atan2(−v_D, v_H), yaw the course over ground atan2(v_E, v_N) — NaN (unknown)
-/// below [`COURSE_MIN_SPEED_M_S`]. The positions are those of the antenna: score
+/// below `COURSE_MIN_SPEED_M_S`. The positions are those of the antenna: score
 /// solutions at the antenna too.
 pub fn reference_from_fixes(g: &GnssFixes) -> Result<NavSolution, EvalError> {
     let n = g.time_s.len();

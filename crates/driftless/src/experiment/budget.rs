@@ -44,7 +44,7 @@ use crate::nav::mechanization::{ImuIncrement, NavState, mechanize};
 use crate::nav::outage::OutageWindow;
 
 /// End errors below this fraction apart are a tie, not a reversal to explain.
-pub const TIE_FRACTION: f64 = 0.05;
+pub(crate) const TIE_FRACTION: f64 = 0.05;
 
 /// One case's budget of one outage (module docs).
 #[derive(Clone, Debug, Serialize, PartialEq)]
@@ -175,7 +175,7 @@ pub(crate) fn outage_budgets(
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ReversalCause {
-    /// The end errors agree to [`TIE_FRACTION`]: nothing to explain.
+    /// The end errors agree to `TIE_FRACTION`: nothing to explain.
     Tie,
     /// The worse case entered the outage with the larger navigation error (its filter
     /// state when GNSS stopped), not with a larger sensor error.
@@ -355,7 +355,7 @@ pub struct ReversalCount {
     pub than: Case,
     /// Outages (over all runs) where `case` ended worse.
     pub worse: usize,
-    /// Of those, the ones worse by more than [`TIE_FRACTION`].
+    /// Of those, the ones worse by more than `TIE_FRACTION`.
     pub worse_beyond_tie: usize,
     /// Outages (over all runs) both finished.
     pub compared: usize,

@@ -5,7 +5,7 @@
 //! | bytes | content |
 //! |---|---|
 //! | 0..8 | magic `DRIFTLOG` |
-//! | 8..12 | format version, `u32` (= [`VERSION`]) |
+//! | 8..12 | format version, `u32` (= `VERSION`) |
 //! | 12..16 | header length `H`, `u32` (≤ 1 MiB) |
 //! | 16..16+H | header: UTF-8 TOML (`source`, `rows`, `tau0_s`, `time_column`, `encoding = "f64le"`, `segments`, `[[gaps]]`, `[[channels]]` with `name`, `quantity`, `source_unit`) |
 //! | … | zero padding to a multiple of 8 bytes |
@@ -30,7 +30,7 @@ use super::log::{Channel, ImuLog, Quantity, TimeGap};
 /// The 8 magic bytes every binary log starts with.
 pub const MAGIC: &[u8; 8] = b"DRIFTLOG";
 /// The format version this build writes and reads.
-pub const VERSION: u32 = 1;
+pub(crate) const VERSION: u32 = 1;
 /// Largest header accepted, bytes.
 const MAX_HEADER: u32 = 1 << 20;
 /// Bytes converted per read/write call.

@@ -54,7 +54,7 @@ pub use binary::{read_binary, read_binary_file, write_binary, write_binary_file}
 pub use error::{Location, LogError};
 pub use input::{InputFormat, LogInput, MAX_CONFIG_BYTES, read_config_text};
 pub use log::{Channel, ImuLog, Quantity, TimeGap};
-pub use rosbag::{BagFormat, Ros2BagFolder, read_rosbag_file};
+pub use rosbag::{BagFormat, read_rosbag_file};
 pub use text::{
     ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, TextOptions, read_text,
     read_text_bytes, read_text_file,

@@ -7,7 +7,7 @@ use std::path::Path;
 
 /// What a path names, following symbolic links.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PathKind {
+pub(crate) enum PathKind {
     /// Nothing there (or not accessible).
     Missing,
     /// A folder.

@@ -225,7 +225,7 @@ pub fn session_config(
 
 /// The inputs of a job, read and checked: the IMU stream, the fixes, the settings.
 #[derive(Debug)]
-pub struct NavInputs {
+pub(crate) struct NavInputs {
     /// The IMU stream (after time offset, mounting and calibration).
     pub imu: ImuStream,
     /// The IMU reader used.
@@ -244,7 +244,7 @@ pub struct NavInputs {
     pub imu_check: ImuCheckReport,
 }
 
-/// Runs the job of `cfg`: [`read_nav_inputs`], the outages, [`run_session`].
+/// Runs the job of `cfg`: `read_nav_inputs`, the outages, [`run_session`].
 pub fn run_nav_job(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavJobResult, NavJobError> {
     run_inputs(read_nav_inputs(cfg, csv)?)
 }
@@ -315,7 +315,10 @@ pub fn run_nav_job_in_memory(
 /// (`imu.format = "csv"`): columns, units, time column. Everything that needs no data
 /// file (noise values, the outage specification, the calibration file) is checked before
 /// the data are read.
-pub fn read_nav_inputs(cfg: &LoadedConfig, csv: &TextOptions) -> Result<NavInputs, NavJobError> {
+pub(crate) fn read_nav_inputs(
+    cfg: &LoadedConfig,
+    csv: &TextOptions,
+) -> Result<NavInputs, NavJobError> {
     let c = &cfg.config;
     let imu_path = required(cfg, "imu.file", &c.imu.file, "IMU")?;
     let gnss_path = required(cfg, "gnss.file", &c.gnss.file, "GNSS")?;

@@ -50,7 +50,7 @@
 //! ([`KfGinsJobOptions::gate`]), and the RTS smoother ([`KfGinsJobOptions::smooth`]), whose
 //! solution is written beside the forward files in the same three formats, with the same
 //! rows, as `KF_GINS_Navresult_smoothed.nav`, `KF_GINS_IMU_ERR_smoothed.txt` and
-//! `KF_GINS_STD_smoothed.txt` ([`SMOOTHED_SUFFIX`]).
+//! `KF_GINS_STD_smoothed.txt` (`SMOOTHED_SUFFIX`).
 //!
 //! # Speed
 //!
@@ -95,7 +95,7 @@ pub struct KfGinsJobOptions {
     /// ([`FilterConfig::gate_recovery_s`], 3 s). `None` (default): no gate and no
     /// recovery, as KF-GINS.
     pub gate: Option<crate::nav::filter::model::Gate>,
-    /// Also run the RTS smoother and write its solution ([`SMOOTHED_SUFFIX`] files).
+    /// Also run the RTS smoother and write its solution (`SMOOTHED_SUFFIX` files).
     pub smooth: bool,
     /// Keep the forward records in [`KfGinsJob::run`] (e.g. for further outputs); implied
     /// by `smooth`.

@@ -318,7 +318,7 @@ pub fn grouped_bars_figure(
 }
 
 /// One case's error curves, one per outage: `(seconds since the outage began, error)`.
-pub type GrowthCurves = Vec<Vec<(f64, f64)>>;
+pub(crate) type GrowthCurves = Vec<Vec<(f64, f64)>>;
 
 /// Error growth inside the outages on a linear y axis: see
 /// [`error_growth_figure_scaled`].

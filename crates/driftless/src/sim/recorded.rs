@@ -50,7 +50,7 @@ use crate::io::nav::GnssFixes;
 use crate::nav::earth;
 
 /// Fewest fixes accepted.
-pub const MIN_POINTS: usize = 6;
+pub(crate) const MIN_POINTS: usize = 6;
 
 /// Roll model of a [`RecordedTrajectory`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -256,7 +256,7 @@ fn attitude_samples(
 }
 
 impl RecordedTrajectory {
-    /// Fits the trajectory to fixes at `time_s` (strictly increasing, ≥ [`MIN_POINTS`])
+    /// Fits the trajectory to fixes at `time_s` (strictly increasing, ≥ `MIN_POINTS`)
     /// with geodetic `lat_rad`, `lon_rad`, `height_m` (all finite, |φ| < 90°). The
     /// trajectory's time axis is `time_s`'s.
     pub fn new(

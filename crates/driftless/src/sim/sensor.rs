@@ -65,9 +65,9 @@ use driftless_model::thermal::ThermalPoly;
 
 use super::noise::{StaticNoiseConfig, generate};
 use super::rng::{Rng, splitmix64};
+pub(crate) use super::sensor_config::MAX_MISALIGNMENT_RAD;
 pub use super::sensor_config::{
-    AccelErrors, AxisNoise, CHANNEL_NAMES, GyroErrors, MAX_MISALIGNMENT_RAD, SensorConfig,
-    TemperatureSensor,
+    AccelErrors, AxisNoise, CHANNEL_NAMES, GyroErrors, SensorConfig, TemperatureSensor,
 };
 pub use super::sensor_data::{IdealImu, OutputKind, SensorOutput, Signal, ideal_sample};
 use super::sensor_error::{SensorSimError, check_finite, check_nonneg};

@@ -16,7 +16,7 @@ use crate::io::Quantity;
 pub const CHANNEL_NAMES: [&str; 6] = ["gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z"];
 
 /// Largest |M_ij| accepted, rad: beyond this the small-angle model is not meaningful.
-pub const MAX_MISALIGNMENT_RAD: f64 = 0.1;
+pub(crate) const MAX_MISALIGNMENT_RAD: f64 = 0.1;
 
 /// Stochastic terms of one axis, continuous-time, SI; u = rad/s (gyro) or m/s² (accel).
 /// Same meaning as the fields of [`StaticNoiseConfig`].

@@ -29,7 +29,6 @@ pub mod soak;
 pub mod stats;
 
 pub use fit::{
-    BIC_PARSIMONY, BandPoint, CrossValidation, FitOptions, HeldOut, NoiseScale, OrderAdvice,
-    OrderRow, ThermalFit, ThermalFitError, advise_order, cross_validate, fit, fit_correlated,
-    held_out,
+    BandPoint, CrossValidation, FitOptions, HeldOut, NoiseScale, OrderAdvice, OrderRow, ThermalFit,
+    ThermalFitError, advise_order, cross_validate, fit, fit_correlated, held_out,
 };

@@ -18,7 +18,9 @@ pub mod noise_id;
 
 pub use chi2::{chi2_cdf, chi2_quantile};
 pub use greenhall::edf_greenhall;
-pub use noise_id::{NoiseId, NoiseIdMethod, acf_noise_id, b1_noise_id, lag1_acf};
+pub(crate) use noise_id::NoiseId;
+pub use noise_id::lag1_acf;
+pub(crate) use noise_id::{acf_noise_id, b1_noise_id};
 
 use super::{AllanError, Estimator};
 
@@ -184,7 +186,7 @@ pub fn bounds(dev: f64, edf: f64, cl: f64) -> (f64, f64) {
 /// α = round(−2(δ + d)) + 2, clamped to [`alpha_range`].
 ///
 /// With fewer than 30 decimated points the B1 ratio with R(n) is used instead
-/// ([`b1_noise_id`], α ∈ −2..=2); with fewer than 4 frequency averages at m, the ACF at
+/// (`b1_noise_id`, α ∈ −2..=2); with fewer than 4 frequency averages at m, the ACF at
 /// the largest factor that still leaves 30 points is used (the noise type of the
 /// longest τ that can be identified). Errors: `m = 0`, non-finite samples, or fewer
 /// than 5 phase points.
@@ -198,7 +200,7 @@ pub fn identify_alpha(phase: &[f64], m: usize, estimator: Estimator) -> Result<i
 }
 
 /// [`identify_alpha`] with the method and its statistics.
-pub fn identify_noise(
+pub(crate) fn identify_noise(
     phase: &[f64],
     m: usize,
     estimator: Estimator,

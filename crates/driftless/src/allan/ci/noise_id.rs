@@ -2,12 +2,12 @@
 //!
 //! Primary method: the lag-1 autocorrelation of W. J. Riley and C. A. Greenhall,
 //! "Power law noise identification using the lag 1 autocorrelation", Proc. 18th EFTF
-//! (2004); NIST SP 1065 §5.6. For fewer than [`MIN_ACF_POINTS`] points after averaging,
+//! (2004); NIST SP 1065 §5.6. For fewer than `MIN_ACF_POINTS` points after averaging,
 //! the B1 bias ratio (Barnes) with the R(n) = MVAR/AVAR ratio to split white from
 //! flicker PM (SP 1065 §5.6, "noise identification using B1 and R(n)").
 
 /// Fewest points the lag-1 ACF method is used on (Riley & Greenhall recommend ≥ 30).
-pub const MIN_ACF_POINTS: usize = 30;
+pub(crate) const MIN_ACF_POINTS: usize = 30;
 
 /// Most decimated points the lag-1 ACF is computed on (the first ones). With 2¹⁴ points
 /// the standard error of r1 is ≈ 1/√n ≈ 0.008, thirty times below the method's
@@ -17,11 +17,11 @@ pub const MIN_ACF_POINTS: usize = 30;
 pub(crate) const MAX_ACF_POINTS: usize = 1 << 14;
 
 /// Fewest frequency averages the B1 ratio is used on (with 2 it is identically 1).
-pub const MIN_B1_POINTS: usize = 4;
+pub(crate) const MIN_B1_POINTS: usize = 4;
 
 /// How an alpha was identified.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum NoiseIdMethod {
+pub(crate) enum NoiseIdMethod {
     /// Lag-1 autocorrelation: `d` differences were taken, δ is the final
     /// r1/(1 + r1), and `p` = −2(δ + d) is the phase-PSD exponent estimate.
     Lag1Acf {
@@ -42,7 +42,7 @@ pub enum NoiseIdMethod {
 
 /// Result of [`identify_noise`](super::identify_noise).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NoiseId {
+pub(crate) struct NoiseId {
     /// Integer noise exponent α (S_y ∝ f^α), clamped to the allowed range.
     pub alpha: i32,
     /// Unrounded estimate of α (for the ACF method p + 2; for B1 the class value).
@@ -101,8 +101,8 @@ fn detrend(x: &mut [f64], deg: usize) {
 /// frequency averaged over m, i.e. the data "averaged by m"), a quadratic (frequency
 /// offset and linear drift) is removed, then the series is differenced until
 /// δ = r1/(1 + r1) < 0.25 or d = `dmax`. The phase-PSD exponent is p = −2(δ + d) and
-/// α = round(p) + 2. Returns `None` with fewer than [`MIN_ACF_POINTS`] decimated points.
-pub fn acf_noise_id(x: &[f64], m: usize, dmax: u32) -> Option<NoiseId> {
+/// α = round(p) + 2. Returns `None` with fewer than `MIN_ACF_POINTS` decimated points.
+pub(crate) fn acf_noise_id(x: &[f64], m: usize, dmax: u32) -> Option<NoiseId> {
     let m = m.max(1);
     let mut z: Vec<f64> = x.iter().step_by(m).take(MAX_ACF_POINTS).copied().collect();
     if z.len() < MIN_ACF_POINTS {
@@ -172,9 +172,9 @@ fn avar_mvar(x: &[f64], m: usize) -> Option<(f64, f64)> {
 }
 
 /// B1 / R(n) identification for short series (SP 1065 §5.6). `None` with fewer than
-/// [`MIN_B1_POINTS`] frequency averages. The B1 ratio cannot see below α = −2 (the Allan
+/// `MIN_B1_POINTS` frequency averages. The B1 ratio cannot see below α = −2 (the Allan
 /// variance diverges there), so it returns α ∈ −2..=2.
-pub fn b1_noise_id(x: &[f64], m: usize) -> Option<NoiseId> {
+pub(crate) fn b1_noise_id(x: &[f64], m: usize) -> Option<NoiseId> {
     let m = m.max(1);
     if x.len() < 2 {
         return None;

@@ -1,6 +1,7 @@
 //! Tests of the public CI API: EDF dispatch, bounds, and noise identification on
 //! synthetic power-law noise made here (xorshift + Box–Muller, no dependencies).
 
+use super::noise_id::NoiseIdMethod;
 use super::*;
 
 /// xorshift64* with Box–Muller normals.

@@ -302,7 +302,7 @@ pub struct GivenValues {
 }
 
 /// The keys of [`GivenValues`] with their SI units.
-pub const GIVEN_KEYS: [(&str, &str); 7] = [
+pub(crate) const GIVEN_KEYS: [(&str, &str); 7] = [
     ("gyroscope_noise_density", "rad/s/sqrt(Hz)"),
     ("gyroscope_random_walk", "rad/s^2/sqrt(Hz)"),
     ("accelerometer_noise_density", "m/s^2/sqrt(Hz)"),
@@ -321,7 +321,7 @@ fn unit_of(key: &str) -> &'static str {
 
 impl FromStr for GivenValues {
     type Err = ExportError;
-    /// `KEY=VALUE[,KEY=VALUE…]` with the keys of [`GIVEN_KEYS`], SI values > 0.
+    /// `KEY=VALUE[,KEY=VALUE…]` with the keys of `GIVEN_KEYS`, SI values > 0.
     fn from_str(s: &str) -> Result<Self, ExportError> {
         let mut g = GivenValues::default();
         for item in s.split(',').map(str::trim).filter(|t| !t.is_empty()) {

@@ -125,28 +125,28 @@ impl FitConfig {
 
 /// Relative model-error floor f of the fit weights: var σ̂²_i = m_i²·(2/ν_i + f²), so a
 /// point never counts as more precise than f, whatever its EDF.
-pub const MODEL_ERROR_FLOOR: f64 = 0.003;
+pub(crate) const MODEL_ERROR_FLOOR: f64 = 0.003;
 
 /// Smallest Gauss-Markov correlation time, in sample intervals: a shorter one is white
 /// noise at every τ the curve has.
-pub const GM_MIN_SAMPLES: f64 = 5.0;
+pub(crate) const GM_MIN_SAMPLES: f64 = 5.0;
 /// Resolution of the Gauss-Markov correlation-time search in ln T (relative, so
 /// 1e-5·(1 + |ln T|): a few 0.01 % of T, far inside its interval).
 pub(super) const GM_LN_T_TOL: f64 = 1e-5;
 /// Largest Gauss-Markov correlation time as a fraction of the record: a longer one is a
 /// random walk over the record and its σ and T cannot be separated.
-pub const GM_MAX_RECORD_FRACTION: f64 = 0.1;
+pub(crate) const GM_MAX_RECORD_FRACTION: f64 = 0.1;
 
 /// What the fit needs to know about the record beyond the curve.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FitOptions {
     /// Sample interval, s (bounds the Gauss-Markov correlation time from below at
-    /// [`GM_MIN_SAMPLES`]·τ0).
+    /// `GM_MIN_SAMPLES`·τ0).
     pub tau0_s: Option<f64>,
     /// Record length, s (bounds the Gauss-Markov correlation time from above at
-    /// [`GM_MAX_RECORD_FRACTION`] of it).
+    /// `GM_MAX_RECORD_FRACTION` of it).
     pub record_s: Option<f64>,
-    /// Relative model-error floor of the weights (see [`MODEL_ERROR_FLOOR`]).
+    /// Relative model-error floor of the weights (see `MODEL_ERROR_FLOOR`).
     pub model_error_floor: f64,
 }
 

@@ -81,14 +81,14 @@ impl std::str::FromStr for FitRangeSpec {
 
 /// Largest averaging factor the automatic range may leave out: the sensor's own
 /// filtering acts over a few to a few tens of samples.
-pub const AUTO_RANGE_MAX_M: usize = 200;
+pub(crate) const AUTO_RANGE_MAX_M: usize = 200;
 /// Smallest lag-1 autocorrelation of the τ-averaged rates that counts as coloured.
-pub const ACF_COLOURED: f64 = 0.02;
+pub(crate) const ACF_COLOURED: f64 = 0.02;
 
 /// Whether the shortest-τ point of a curve is coloured by the sensor's own filtering:
-/// the lag-1 autocorrelation r₁ of the rate samples lies above max([`ACF_COLOURED`],
+/// the lag-1 autocorrelation r₁ of the rate samples lies above max(`ACF_COLOURED`,
 /// 3/√n) (white noise gives r₁ ≈ 0 with standard error 1/√n; Box & Jenkins 1976
-/// §2.1.6) or below −[`ACF_COLOURED`] while above −0.3 (a narrow-band hump; quantization
+/// §2.1.6) or below −`ACF_COLOURED` while above −0.3 (a narrow-band hump; quantization
 /// alone gives r₁ → −½ and is a modelled term). `acf1` is the curve's
 /// [`crate::allan::analysis::ChannelResult::rate_acf1`], `n_samples` the samples behind it.
 pub fn short_tau_coloured(acf1: &[f64], n_samples: usize) -> bool {
@@ -101,7 +101,7 @@ pub fn short_tau_coloured(acf1: &[f64], n_samples: usize) -> bool {
 
 /// Candidate first points of the automatic fit range: the curve's first point, then
 /// points whose averaging factor m has grown by at least half since the previous
-/// candidate, up to m = [`AUTO_RANGE_MAX_M`].
+/// candidate, up to m = `AUTO_RANGE_MAX_M`.
 pub fn auto_range_candidates(m: &[usize]) -> Vec<usize> {
     let mut out = Vec::new();
     let mut last = 0usize;

@@ -161,7 +161,7 @@ pub struct NotIdentifiable {
 /// χ²_red above which a fit is reported as not describing the curve.
 pub const CHI2_RED_WARN: f64 = 5.0;
 /// χ²_red up to which a fit is reported as following the curve within its uncertainty.
-pub const CHI2_RED_GOOD: f64 = 2.0;
+pub(crate) const CHI2_RED_GOOD: f64 = 2.0;
 
 /// Plain-words reading of χ²_red and whether it deserves a warning.
 pub fn chi2_verdict(chi2_red: f64) -> (&'static str, bool) {

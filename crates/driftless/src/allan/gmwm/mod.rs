@@ -65,7 +65,7 @@ use crate::io::Quantity;
 pub use solve::{fit_gmwm, simulate};
 
 /// Largest number of Gauss–Markov terms a GMWM model may hold.
-pub const MAX_GAUSS_MARKOV: usize = 4;
+pub(crate) const MAX_GAUSS_MARKOV: usize = 4;
 
 /// One process of a GMWM model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -279,7 +279,7 @@ pub struct GmwmConfig {
     pub random_walk: bool,
     /// Drift may enter.
     pub drift: bool,
-    /// Up to this many Gauss–Markov terms (0 ..= [`MAX_GAUSS_MARKOV`]).
+    /// Up to this many Gauss–Markov terms (0 ..= `MAX_GAUSS_MARKOV`).
     pub max_gauss_markov: usize,
     /// Confidence level of the parameter intervals.
     pub confidence: f64,
@@ -416,7 +416,7 @@ pub struct GmwmFit {
 
 /// Gauss–Markov terms (other than the slowest) with T below this many sample intervals
 /// are white noise to a filter and go into the file's `white` term.
-pub const WHITE_FOLD_SAMPLES: f64 = 10.0;
+pub(crate) const WHITE_FOLD_SAMPLES: f64 = 10.0;
 
 /// The criterion as reported.
 pub const CRITERION: &str = "WIC = J(theta) + 2p (GMM objective with the diagonal eta3 \
@@ -444,7 +444,7 @@ impl GmwmFit {
     /// Gauss–Markov term of longest correlation time → `gauss_markov` (the complete model
     /// is kept in [`ChannelNoise::gmwm`]). `chi2_reduced` is J/(J_scales − p).
     ///
-    /// Any other Gauss–Markov term with T < [`WHITE_FOLD_SAMPLES`]·τ0 is, for a filter
+    /// Any other Gauss–Markov term with T < `WHITE_FOLD_SAMPLES`·τ0 is, for a filter
     /// or simulator, white noise: it is folded into `white` with its low-frequency
     /// density N² = 2σ_b²T (the two-sided PSD at f = 0; Gelb 1974, §4.4), so that a
     /// model whose "white" part the GMWM found correlated over a few samples still

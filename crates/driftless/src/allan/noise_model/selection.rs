@@ -14,12 +14,12 @@ use super::display::fmt_num;
 /// Relative half-width of the 68.3 % interval of σ̂(τ) up to which the automatic fit
 /// range reaches: a model can be held to ±10 % of the curve only where the curve itself
 /// is known to 10 %.
-pub const CURVE_PRECISION: f64 = 0.10;
+pub(crate) const CURVE_PRECISION: f64 = 0.10;
 /// Confidence level of the curve interval [`CURVE_PRECISION`] applies to (one σ).
-pub const CURVE_PRECISION_CONFIDENCE: f64 = 0.683;
+pub(crate) const CURVE_PRECISION_CONFIDENCE: f64 = 0.683;
 
 /// Fewest curve points the automatic range keeps, whatever their precision.
-pub const AUTO_RANGE_MIN_POINTS: usize = 12;
+pub(crate) const AUTO_RANGE_MIN_POINTS: usize = 12;
 
 /// End (exclusive) of the automatic fit range: before the first point whose 68.3 %
 /// interval reaches beyond ±`precision` of σ̂, with the EDF ν of the long-τ noise types
@@ -30,7 +30,7 @@ pub const AUTO_RANGE_MIN_POINTS: usize = 12;
 /// scatter by more than the tolerance a model is held to, and on real sensors the
 /// longest τ carry slow effects (temperature, run-to-run changes of the bias) that no
 /// stationary term describes; they stay on the curve, with their intervals, but do not
-/// shape the model. At least [`AUTO_RANGE_MIN_POINTS`]
+/// shape the model. At least `AUTO_RANGE_MIN_POINTS`
 /// points are kept.
 pub fn auto_fit_end(c: &ChannelResult, precision: f64) -> usize {
     let n = c.points.len();
@@ -49,7 +49,7 @@ pub fn auto_fit_end(c: &ChannelResult, precision: f64) -> usize {
 }
 
 /// Quantization above this multiple of Δτ0/√12 is not taken as quantization.
-pub const QUANTIZATION_RESOLUTION_FACTOR: f64 = 3.0;
+pub(crate) const QUANTIZATION_RESOLUTION_FACTOR: f64 = 3.0;
 
 /// The curve points inside a user range, [i0, i1).
 pub(super) fn user_indices(
@@ -161,7 +161,7 @@ where
 
 /// What a term the data do not support is reported as instead of a value.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Unsupported {
+pub(crate) enum Unsupported {
     /// Its interval reaches zero: the upper end of the interval is the upper limit.
     UpperLimit(UpperLimit),
     /// Its value cannot be what the term describes (see [`least_supported_term`]).
@@ -169,13 +169,13 @@ pub enum Unsupported {
 }
 
 /// The term of `fit` the data support least, if any does not stand:
-/// * a quantization above [`QUANTIZATION_RESOLUTION_FACTOR`]·Δτ0/√12 — what angle
+/// * a quantization above `QUANTIZATION_RESOLUTION_FACTOR`·Δτ0/√12 — what angle
 ///   increments quantized at the rate resolution step Δ = `step` would give (IEEE Std
 ///   952-1997 C.1) — is not quantization (filtering, a spectral hump): not identifiable;
 /// * otherwise, of the terms whose interval reaches zero, the one with the smallest
 ///   significance θ/(z·s_θ) (θ the squared coefficient, z·s_θ its interval half-width,
 ///   so θ/(z·s_θ) = v²/(hi² − v²)): an upper limit at its interval's upper end.
-pub fn least_supported_term(
+pub(crate) fn least_supported_term(
     fit: &NoiseFit,
     step: Option<f64>,
     tau0_s: f64,
@@ -229,7 +229,7 @@ pub fn least_supported_term(
 }
 
 /// The fit with physically possible, resolved terms only, by backward elimination: fit
-/// with `cfg`, drop the [`least_supported_term`], refit without it and repeat until every
+/// with `cfg`, drop the `least_supported_term`, refit without it and repeat until every
 /// remaining term stands. Each dropped term is reported (upper limit or not
 /// identifiable) from the fit that still had it; the returned fit's values, χ²_red and
 /// model curve are those of the terms that stand, so the saved model is the model

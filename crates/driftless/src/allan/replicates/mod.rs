@@ -73,7 +73,7 @@ pub(crate) const CROSS_CHECK_TAU_S: (f64, f64) = (0.2, 30.0);
 
 /// Largest relative difference of the runs' sample intervals taken as one sample rate
 /// (timestamps of real logs give slightly different estimates of one nominal rate).
-pub const SAMPLE_RATE_TOLERANCE: f64 = 1e-3;
+pub(crate) const SAMPLE_RATE_TOLERANCE: f64 = 1e-3;
 
 /// One run: its name (file), the OADEV curves its noise model was fitted to and that
 /// model.
@@ -308,7 +308,7 @@ fn cross_check(
 /// What two runs must share to be replicates: channels (name, quantity) and the sample
 /// interval. Known once the logs are read, before any analysis.
 #[derive(Clone, Debug, PartialEq)]
-pub struct RunShape<'a> {
+pub(crate) struct RunShape<'a> {
     /// Name of the run (its file).
     pub source: &'a str,
     /// The analysed channels: name and quantity.
@@ -385,7 +385,7 @@ pub(crate) fn check_same_sensor(
 ///
 /// Channels are matched by name; the runs must have the same channels with the same
 /// quantities, the same estimator and confidence, and sample rates within
-/// [`SAMPLE_RATE_TOLERANCE`] — otherwise the error names both files and what differs.
+/// `SAMPLE_RATE_TOLERANCE` — otherwise the error names both files and what differs.
 pub fn compare_replicates(
     runs: &[ReplicateRun<'_>],
     opts: &ReplicateOptions,

@@ -8,7 +8,7 @@
 //!
 //! **UTC.** GPST = UTC + (GPS − UTC), where GPS − UTC is a whole number of leap seconds
 //! that grows each time the IERS inserts one: [`gps_minus_utc_s`] looks it up in
-//! [`LEAP_SECONDS`] (18 s since 2017-01-01). Unix time counts UTC days of 86 400 s, so
+//! `LEAP_SECONDS` (18 s since 2017-01-01). Unix time counts UTC days of 86 400 s, so
 //! Unix seconds map to a UTC calendar date without leap seconds, and the table is indexed
 //! by that date.
 
@@ -30,7 +30,7 @@ pub(crate) const GPS_EPOCH_UNIX_S: f64 = 315_964_800.0;
 /// TAI − UTC was 19 s. Each leap second was inserted at 23:59:60 UTC of the day before the
 /// date given. No leap second has been inserted since 2017-01-01, and the IERS Bulletins C
 /// published up to the end of 2025 announce none; a later announcement needs a new row here.
-pub const LEAP_SECONDS: [((i32, u32, u32), i32); 18] = [
+pub(crate) const LEAP_SECONDS: [((i32, u32, u32), i32); 18] = [
     ((1981, 7, 1), 1),
     ((1982, 7, 1), 2),
     ((1983, 7, 1), 3),
@@ -83,7 +83,7 @@ pub enum TimeBaseError {
 }
 
 /// GPS − UTC, s, at the UTC instant `unix_utc_s` (Unix seconds: UTC days × 86 400 + seconds
-/// of the UTC day), from [`LEAP_SECONDS`]; 0 before 1981-07-01. Errors before the GPS epoch.
+/// of the UTC day), from `LEAP_SECONDS`; 0 before 1981-07-01. Errors before the GPS epoch.
 ///
 /// A Unix time inside an inserted leap second (23:59:60, which Unix time cannot name) reads
 /// as the following day's 00:00:00, i.e. with the new count.
@@ -123,7 +123,7 @@ pub enum TimeBase {
     /// seconds, as RTKLIB's `gtime_t` (`gpst-unix`): GPS s = t − 315 964 800.
     GpstUnix,
     /// Ordinary Unix time, UTC (`utc-unix`): GPS s = t − 315 964 800 + (GPS − UTC)(t),
-    /// with the leap seconds of [`LEAP_SECONDS`].
+    /// with the leap seconds of `LEAP_SECONDS`.
     UtcUnix,
 }
 

@@ -25,9 +25,7 @@ pub mod types {
     pub use crate::data::nav::*;
 }
 
-pub use gpstime::{
-    GpsTime, LEAP_SECONDS, ParseTimeBaseError, TimeBase, TimeBaseError, gps_minus_utc_s,
-};
+pub use gpstime::{GpsTime, ParseTimeBaseError, TimeBase, TimeBaseError, gps_minus_utc_s};
 pub use kfgins::{
     GnssReadOptions, KfGinsOutputWriter, KfGinsRow, ZeroSigma, read_kfgins_gnss,
     read_kfgins_gnss_file, read_kfgins_imu, read_kfgins_imu_file, write_kfgins_gnss,

@@ -3,7 +3,7 @@
 //!
 //! [`lock_folder`] takes an exclusive advisory lock ([`File::try_lock`], `flock` on unix)
 //! on the folder itself, opened read-only, so no lock file is left behind; elsewhere the
-//! lock is taken on a [`LOCK_FILE`] inside the folder, which stays. The lock is released
+//! lock is taken on a `LOCK_FILE` inside the folder, which stays. The lock is released
 //! when the [`FolderLock`] is dropped or the process ends in any way, `kill -9` included.
 //! A second run into a locked folder fails at once instead of mixing its files with the
 //! first one's.
@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 /// The lock file inside an output folder where a folder itself cannot be locked
 /// (non-unix platforms). Never counted as another run's file.
-pub const LOCK_FILE: &str = ".driftless.lock";
+pub(crate) const LOCK_FILE: &str = ".driftless.lock";
 
 /// An output folder held by this run: while it lives, every other driftless run that
 /// tries to write the folder is refused. Keep it until every file is committed.

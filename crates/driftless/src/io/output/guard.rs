@@ -96,7 +96,7 @@ pub fn refuse_same_file<P: AsRef<Path>>(
 /// Refuses an output folder that exists and holds anything, unless `force`: its files would
 /// mix with this run's. A missing or empty folder is fine; so is one that holds only
 /// temporary files of ended runs ([`super::is_stale_partial`]) and the
-/// [`super::folder::LOCK_FILE`].
+/// `LOCK_FILE`.
 pub fn refuse_folder_in_use(dir: impl AsRef<Path>, force: bool) -> Result<(), OutputError> {
     let dir = dir.as_ref();
     if force {

@@ -9,7 +9,7 @@ use crate::io::error::{Location, LogError};
 /// A ROS 2 bag folder (one holding `metadata.yaml`): its storage files in recording order
 /// and the compression its metadata declares.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Ros2BagFolder {
+pub(crate) struct Ros2BagFolder {
     /// The storage files (`.mcap`, `.db3`), in the order `relative_file_paths` lists them.
     pub storage: Vec<PathBuf>,
     /// Whether each message is Zstandard-compressed (`compression_mode: message`).
@@ -19,7 +19,7 @@ pub struct Ros2BagFolder {
 /// The ROS 2 bag folder at `dir`: `None` when `dir` holds no `metadata.yaml`; an error when
 /// the metadata cannot be read, names a missing file, declares whole-file compression, or
 /// (without `relative_file_paths`) the folder holds no `.mcap` / `.db3` file.
-pub fn ros2_bag_folder(dir: &Path) -> Result<Option<Ros2BagFolder>, LogError> {
+pub(crate) fn ros2_bag_folder(dir: &Path) -> Result<Option<Ros2BagFolder>, LogError> {
     use saphyr::{Scalar, YamlData};
     let meta = dir.join("metadata.yaml");
     if !meta.is_file() {

@@ -42,7 +42,7 @@ use std::path::Path;
 
 use super::error::{Location, LogError};
 use super::log::{Channel, ImuLog, Quantity};
-pub use folder::{Ros2BagFolder, ros2_bag_folder};
+pub(crate) use folder::{Ros2BagFolder, ros2_bag_folder};
 
 /// Which robotics log format an input holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -67,11 +67,11 @@ impl BagFormat {
 }
 
 /// The ROS 1 bag magic line (format 2.0).
-pub const ROS1_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
+pub(crate) const ROS1_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
 /// The MCAP magic (MCAP specification, "Magic").
-pub const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
+pub(crate) const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
 /// The start of an sqlite3 database file.
-pub const SQLITE_MAGIC: &[u8] = b"SQLite format 3\0";
+pub(crate) const SQLITE_MAGIC: &[u8] = b"SQLite format 3\0";
 
 /// The format shown by the first bytes of an input (at least 8 are needed).
 pub fn detect_format(head: &[u8]) -> Option<BagFormat> {
@@ -121,7 +121,7 @@ pub fn read_rosbag(
 
 /// [`read_rosbag_file`] of a bag whose first storage file is `first` (opened, named
 /// `name`) and, for a ROS 2 bag folder, the rest of `folder.storage` after it.
-pub fn read_rosbag_parts(
+pub(crate) fn read_rosbag_parts(
     first: std::fs::File,
     name: &str,
     folder: Option<&Ros2BagFolder>,

@@ -24,7 +24,7 @@ pub(super) fn split_name_unit(raw: &str) -> (String, Option<String>) {
 
 /// Header names (case-insensitive, unit in brackets stripped, a leading `#` ignored)
 /// taken for the time column when none is given.
-pub const TIME_COLUMN_NAMES: [&str; 10] = [
+pub(crate) const TIME_COLUMN_NAMES: [&str; 10] = [
     "t",
     "time",
     "timestamp",

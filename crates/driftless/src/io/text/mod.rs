@@ -68,7 +68,6 @@ mod plan;
 mod read;
 mod time;
 
-pub use header::TIME_COLUMN_NAMES;
 pub use options::{
     ColumnRef, ColumnSpec, Delimiter, GapPolicy, HeaderMode, ParseSpecError, TextOptions,
 };

@@ -82,10 +82,10 @@ pub struct TextOptions {
     /// when there is a header, and instead of `col1`, `col2`, … when there is none.
     pub column_names: Option<Vec<String>>,
     /// The time column, or `None`: then a header field named as a time column
-    /// ([`TIME_COLUMN_NAMES`](super::TIME_COLUMN_NAMES), when `detect_time_column`) is taken, else the log has no
+    /// (`TIME_COLUMN_NAMES`, when `detect_time_column`) is taken, else the log has no
     /// time stamps and `rate_hz` is needed.
     pub time_column: Option<ColumnRef>,
-    /// Take a header field named as a time column ([`TIME_COLUMN_NAMES`](super::TIME_COLUMN_NAMES)) for the time
+    /// Take a header field named as a time column (`TIME_COLUMN_NAMES`) for the time
     /// when `time_column` is `None` (on by default; off reads such a field as data).
     pub detect_time_column: bool,
     /// Unit of the time column; `None` takes the header's bracketed unit, else seconds.

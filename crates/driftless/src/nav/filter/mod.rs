@@ -41,9 +41,7 @@ pub use align::{
     AlignConfig, Alignment, coarse_align_static, heading_from_gnss_velocity, level_static,
 };
 pub use eskf::{Eskf, UpdateKind, UpdateOutcome};
-pub use model::{
-    FilterConfig, GATE_CHOICES, Gate, GaussMarkov, ImuNoise, QualityScale, Transition,
-};
+pub use model::{FilterConfig, Gate, GaussMarkov, ImuNoise, QualityScale, Transition};
 pub use run::{
     EpochRecord, ForwardRun, InitialState, RecoveryEvent, RecoveryTrigger, RunOptions,
     UpdateRecord, run_forward, run_forward_observed, run_forward_with,

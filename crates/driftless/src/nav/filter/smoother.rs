@@ -73,9 +73,9 @@
 //! configuration's Q (the forward pass's own code, so the result is bit-identical; the
 //! re-propagated prior at the segment end is compared with the stored prior and a
 //! mismatch — a different configuration — is an error), into a scratch buffer, then swept
-//! backwards. Segments longer than [`CHUNK`] epochs (long outages) are re-propagated
-//! twice, keeping only a checkpoint every [`CHUNK`] epochs, so the scratch never exceeds
-//! [`CHUNK`] × (3528 B covariance + 904 B transition) ≈ 18 MB.
+//! backwards. Segments longer than `CHUNK` epochs (long outages) are re-propagated
+//! twice, keeping only a checkpoint every `CHUNK` epochs, so the scratch never exceeds
+//! `CHUNK` × (3528 B covariance + 904 B transition) ≈ 18 MB.
 //!
 //! Output: one [`SmoothedEpoch`] per forward record, **352 B per epoch** (navigation
 //! state 88 B, sensor errors 96 B, 21 σ 168 B; 1 h at 200 Hz: 253 MB, on top of the
@@ -98,7 +98,7 @@ use crate::nav::earth;
 use crate::nav::mechanization::{NavState, mechanize};
 
 /// Longest stretch of epochs whose covariances are held at once (see the module docs).
-pub const CHUNK: usize = 4096;
+pub(crate) const CHUNK: usize = 4096;
 
 /// Relative tolerance of the re-propagated prior against the stored prior.
 const REBUILD_TOL: f64 = 1e-9;

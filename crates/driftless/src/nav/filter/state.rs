@@ -32,13 +32,13 @@ pub const SG: usize = 15;
 pub const SA: usize = 18;
 
 /// A full 21 × 21 covariance (row-major, symmetric).
-pub type Cov = [[f64; N_STATES]; N_STATES];
+pub(crate) type Cov = [[f64; N_STATES]; N_STATES];
 
 /// Number of elements of the packed upper triangle of a [`Cov`].
 pub(crate) const N_PACKED: usize = N_STATES * (N_STATES + 1) / 2;
 
 /// Packed upper triangle (row by row: (0,0), (0,1), …, (0,20), (1,1), …) of a covariance.
-pub type PackedCov = [f64; N_PACKED];
+pub(crate) type PackedCov = [f64; N_PACKED];
 
 /// Pack the upper triangle of `p`.
 pub(crate) fn pack(p: &Cov) -> Box<PackedCov> {

@@ -69,7 +69,7 @@ pub enum MarkerShape {
 
 /// Default marker shapes, cycled like [`PALETTE`] so that series stay
 /// distinguishable in grey-scale print.
-pub const MARKER_CYCLE: [MarkerShape; 4] = [
+pub(crate) const MARKER_CYCLE: [MarkerShape; 4] = [
     MarkerShape::Circle,
     MarkerShape::Square,
     MarkerShape::Triangle,
@@ -103,7 +103,7 @@ pub struct Series {
     pub y_hi: Option<Vec<f64>>,
     /// `None`: next colour of [`PALETTE`].
     pub color: Option<Color>,
-    /// `None`: next shape of [`MARKER_CYCLE`].
+    /// `None`: next shape of `MARKER_CYCLE`.
     pub marker: Option<MarkerShape>,
     /// Join consecutive valid points with a thin line.
     pub connect: bool,
@@ -483,7 +483,7 @@ impl Plot {
 
 /// Default size of one panel in px (CSS px in SVG; PNG multiplies by its
 /// scale factor).
-pub const DEFAULT_PANEL_SIZE: (f64, f64) = (640.0, 480.0);
+pub(crate) const DEFAULT_PANEL_SIZE: (f64, f64) = (640.0, 480.0);
 
 /// One or more panels on a grid, with an optional overall title.
 ///

@@ -60,8 +60,8 @@ use std::path::Path;
 
 pub use error::PlotError;
 pub use figure::{
-    Annotation, AxisScale, Bars, Color, DEFAULT_PANEL_SIZE, Figure, LegendPosition, Line,
-    LineStyle, LogLogPlot, MARKER_CYCLE, MarkerShape, PALETTE, Plot, Series,
+    Annotation, AxisScale, Bars, Color, Figure, LegendPosition, Line, LineStyle, LogLogPlot,
+    MarkerShape, PALETTE, Plot, Series,
 };
 pub use svg::xml_escape;
 pub use text::text_width;
@@ -71,7 +71,7 @@ pub(crate) const PNG_SUPPORTED: bool = cfg!(feature = "png");
 
 /// Default PNG resolution: 2 device pixels per SVG px (crisp text on
 /// high-DPI screens and in print).
-pub const DEFAULT_PNG_SCALE: f64 = 2.0;
+pub(crate) const DEFAULT_PNG_SCALE: f64 = 2.0;
 
 /// Writes the figure as PNG when `path` ends in `.png`, as SVG when it ends in `.svg`
 /// (any case).
@@ -136,7 +136,7 @@ pub fn render_png_bytes(fig: &Figure, scale: f64) -> Result<Vec<u8>, PlotError> 
     }
 }
 
-/// Writes the figure as a PNG file at [`DEFAULT_PNG_SCALE`].
+/// Writes the figure as a PNG file at `DEFAULT_PNG_SCALE`.
 ///
 /// # Errors
 /// As [`render_png_bytes`], plus [`PlotError::Io`] if the file cannot be

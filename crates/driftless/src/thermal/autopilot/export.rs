@@ -31,7 +31,7 @@ pub(super) fn binomial(n: usize, k: usize) -> f64 {
 
 /// A parameter value as the autopilots store it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ParamValue {
+pub(crate) enum ParamValue {
     /// float32 (MAV_PARAM_TYPE_REAL32 = 9).
     Float(f32),
     /// int32 (MAV_PARAM_TYPE_INT32 = 6).
@@ -56,7 +56,7 @@ impl ParamValue {
 
 /// One named parameter.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Param {
+pub(crate) struct Param {
     /// Parameter name.
     pub name: String,
     /// Its value.

@@ -275,7 +275,7 @@ pub struct OrderAdvice {
     pub rows: Vec<OrderRow>,
     /// Order with the lowest BIC (ties → lower order).
     pub min_bic: usize,
-    /// Recommended order: the lowest order whose BIC is within [`BIC_PARSIMONY`] (= 2) of
+    /// Recommended order: the lowest order whose BIC is within `BIC_PARSIMONY` (= 2) of
     /// the minimum — a higher order is adopted only on at least "positive" evidence
     /// (ΔBIC > 2, Kass & Raftery, JASA 90:773, 1995). BIC's ln n penalty already favours
     /// parsimony more than AIC, which suits extrapolation-prone polynomials (Burnham &
@@ -284,7 +284,7 @@ pub struct OrderAdvice {
 }
 
 /// ΔBIC margin below which the lower order is preferred (see [`OrderAdvice::recommended`]).
-pub const BIC_PARSIMONY: f64 = 2.0;
+pub(crate) const BIC_PARSIMONY: f64 = 2.0;
 
 /// Compare orders by AIC, AICc, BIC and CV (Burnham & Anderson, *Model Selection and
 /// Multimodel Inference*, 2nd ed., 2002, §2.2–2.4, §6.3), with the Gaussian likelihood:

@@ -246,7 +246,7 @@ pub(super) fn output_paths(dir: &Path) -> [PathBuf; 3] {
 
 /// Suffix of the smoothed solution's files: `KF_GINS_Navresult_smoothed.nav`,
 /// `KF_GINS_IMU_ERR_smoothed.txt`, `KF_GINS_STD_smoothed.txt` (same formats).
-pub const SMOOTHED_SUFFIX: &str = "_smoothed";
+pub(crate) const SMOOTHED_SUFFIX: &str = "_smoothed";
 
 /// KF-GINS's three output file names with `suffix` before the extension (`""`: KF-GINS's
 /// own names).

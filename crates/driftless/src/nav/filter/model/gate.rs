@@ -67,7 +67,7 @@ impl Default for Gate {
 }
 
 /// The accepted text forms of a [`Gate`], for error messages.
-pub const GATE_CHOICES: &str = "off, chi2:P (P a probability in (0, 1), e.g. chi2:0.9999), \
+pub(crate) const GATE_CHOICES: &str = "off, chi2:P (P a probability in (0, 1), e.g. chi2:0.9999), \
      robust, or robust:P_INFLATE:P_REJECT:MAX_SIGMA_SCALE (e.g. robust:0.99:0.9999:100)";
 
 impl Gate {
