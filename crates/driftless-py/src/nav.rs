@@ -20,7 +20,7 @@ use numpy::{IntoPyArray, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::value_error;
+use crate::{owned, value_error};
 
 /// The default configuration in its serde form (JSON text): the keys a dict may set.
 #[pyfunction]
@@ -197,10 +197,6 @@ fn job_dict<'py>(
         serde_json::to_string(&config.config).map_err(value_error)?,
     )?;
     Ok(d)
-}
-
-fn owned(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
-    crate::owned(a)
 }
 
 fn triads(cols: &[PyReadonlyArray1<'_, f64>]) -> Vec<[f64; 3]> {

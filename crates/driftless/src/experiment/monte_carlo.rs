@@ -299,6 +299,38 @@ pub(crate) fn summarise(runs: &[VehicleRun], confidence: f64, seed: u64) -> Mont
     }
 }
 
+/// Run `i` ≥ 1 (not detailed): its own chamber when the chamber is simulated (redrawn
+/// per run), else run 0's thermal stage (a model file is read once), then the vehicle.
+pub(super) fn later_run(
+    p: &Prepared,
+    noise: Option<&NoiseStage>,
+    run0_thermal: Option<&ThermalStage>,
+    i: usize,
+) -> Result<VehicleRun, ExperimentError> {
+    let redraw = (p.scenario.chamber.as_ref()).is_some_and(|c| c.protocol.is_some());
+    let redrawn = if redraw {
+        thermal_stage(p, noise, i)?
+    } else {
+        None
+    };
+    let thermal = if redraw {
+        redrawn.as_ref()
+    } else {
+        run0_thermal
+    };
+    vehicle_run(p, noise, thermal, i, false)
+}
+
+/// The statistics of runs 0…K−1 (in run order) at the scenario's confidence, with the
+/// bootstrap seeded from the scenario seed.
+pub(super) fn summarise_runs(p: &Prepared, runs: &[VehicleRun]) -> MonteCarloSummary {
+    summarise(
+        runs,
+        p.scenario.monte_carlo.confidence,
+        splitmix64_mix(p.scenario.seed ^ 0xB007),
+    )
+}
+
 /// Runs the whole experiment: the noise stage once, then `runs` (default: the
 /// scenario's) chamber + vehicle runs. `progress(stage, done, total)` is called as
 /// stages finish.
@@ -327,19 +359,7 @@ pub fn run_experiment(
     let rest: Vec<VehicleRun> = (1..k)
         .into_par_iter()
         .map(|i| {
-            // A simulated chamber is redrawn per run; a model file is read once.
-            let redrawn = if p
-                .scenario
-                .chamber
-                .as_ref()
-                .is_some_and(|c| c.protocol.is_some())
-            {
-                Some(thermal_stage(p, noise.as_ref(), i)?)
-            } else {
-                None
-            };
-            let t = redrawn.as_ref().map_or(thermal.as_ref(), Option::as_ref);
-            let r = vehicle_run(p, noise.as_ref(), t, i, false)?;
+            let r = later_run(p, noise.as_ref(), thermal.as_ref(), i)?;
             let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress("runs", d, k as u64);
             Ok(r)
@@ -348,11 +368,7 @@ pub fn run_experiment(
     let mut all = Vec::with_capacity(k);
     all.push(detailed.without_solutions());
     all.extend(rest);
-    let summary = summarise(
-        &all,
-        p.scenario.monte_carlo.confidence,
-        splitmix64_mix(p.scenario.seed ^ 0xB007),
-    );
+    let summary = summarise_runs(p, &all);
     Ok(ExperimentResult {
         noise,
         thermal,

@@ -11,13 +11,12 @@
 //! stage; a worker builds it once and runs many indices with it.
 
 use super::ExperimentError;
-use super::monte_carlo::{MonteCarloSummary, summarise};
+use super::monte_carlo::{MonteCarloSummary, later_run, summarise_runs};
 use super::run::{
     Case, CaseRun, NoiseStage, Prepared, ThermalStage, VehicleRun, noise_stage, thermal_stage,
     vehicle_run,
 };
 use crate::eval::metrics::{OutageErrors, OutageReport, OutageSummary, Stat};
-use crate::numeric::splitmix::splitmix64_mix;
 
 /// What every run of an experiment shares (module docs).
 #[derive(Debug)]
@@ -57,19 +56,11 @@ impl MonteCarloContext {
                 "run {run}: a recorded run cannot be redrawn; Monte Carlo needs a simulated [vehicle]"
             )));
         }
-        let redraw = run > 0 && (p.scenario.chamber.as_ref()).is_some_and(|c| c.protocol.is_some());
-        let redrawn = if redraw {
-            thermal_stage(p, self.noise.as_ref(), run)?
-        } else {
-            None
-        };
-        let thermal = if redraw {
-            redrawn.as_ref()
-        } else {
-            self.thermal.as_ref()
-        };
-        let r = vehicle_run(p, self.noise.as_ref(), thermal, run, run == 0)?;
-        Ok(if run == 0 { r.without_solutions() } else { r })
+        if run == 0 {
+            let r = vehicle_run(p, self.noise.as_ref(), self.thermal.as_ref(), 0, true)?;
+            return Ok(r.without_solutions());
+        }
+        later_run(p, self.noise.as_ref(), self.thermal.as_ref(), run)
     }
 }
 
@@ -239,11 +230,7 @@ pub fn summarise_records(
         }
     }
     let runs: Vec<VehicleRun> = sorted.iter().map(|r| r.vehicle_run(p)).collect();
-    Ok(summarise(
-        &runs,
-        p.scenario.monte_carlo.confidence,
-        splitmix64_mix(p.scenario.seed ^ 0xB007),
-    ))
+    Ok(summarise_runs(p, &runs))
 }
 
 #[cfg(test)]
